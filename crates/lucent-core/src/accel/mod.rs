@@ -1,0 +1,132 @@
+//! Acceleration structures: one file per structure, all behind one trait so the
+//! renderer and the tests can swap them (`lucent render --accel`).
+//!
+//! Every structure must return exactly the hit the brute-force [`list::PrimitiveList`]
+//! returns. Two rules make that possible: each primitive test is the same function
+//! everywhere (so the same ray and primitive give the same `t` to the bit), and ties in
+//! `t` go to the primitive that comes first in the scene ([`Hit::is_closer_than`]).
+
+pub mod bvh;
+pub mod list;
+
+use crate::hit::Hit;
+use crate::primitive::Primitive;
+use crate::ray::Ray;
+
+pub trait Accelerator: Send + Sync {
+    /// The closest hit with `ray.t_min < t <= ray.t_max`.
+    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit>;
+    /// Whether anything lies in `(ray.t_min, ray.t_max]` (shadow rays).
+    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool;
+    /// Bytes used by the structure itself (not counting the primitives).
+    fn memory_bytes(&self) -> usize;
+}
+
+/// The structures `lucent render --accel` offers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AccelKind {
+    Bvh,
+    List,
+}
+
+impl AccelKind {
+    pub const ALL: [AccelKind; 2] = [AccelKind::Bvh, AccelKind::List];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelKind::Bvh => "bvh",
+            AccelKind::List => "list",
+        }
+    }
+
+    pub fn build(self, prims: &[Primitive]) -> Box<dyn Accelerator> {
+        match self {
+            AccelKind::Bvh => Box::new(bvh::Bvh::build(prims)),
+            AccelKind::List => Box::new(list::PrimitiveList::new(prims.len())),
+        }
+    }
+}
+
+impl std::str::FromStr for AccelKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        AccelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown acceleration structure '{s}' (expected bvh or list)"))
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_scenes {
+    //! Random and degenerate primitive soups shared by the structures' tests.
+    use crate::math::{Affine3A, Vec3, Vec3A};
+    use crate::primitive::{Primitive, Shape, Sphere};
+
+    pub struct Rng(pub u64);
+    impl Rng {
+        pub fn next(&mut self) -> f32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((self.0 >> 40) as f32) / (1u64 << 24) as f32
+        }
+        pub fn range(&mut self, a: f32, b: f32) -> f32 {
+            a + (b - a) * self.next()
+        }
+        pub fn vec(&mut self, s: f32) -> Vec3A {
+            Vec3A::new(self.range(-s, s), self.range(-s, s), self.range(-s, s))
+        }
+    }
+
+    pub fn soup(seed: u64, n: usize) -> Vec<Primitive> {
+        let mut rng = Rng(seed);
+        (0..n)
+            .map(|i| {
+                let c = rng.vec(10.0);
+                let shape = if i % 5 == 0 {
+                    let m = Affine3A::from_translation(c.into())
+                        * Affine3A::from_scale(Vec3::new(
+                            rng.range(0.1, 1.0),
+                            rng.range(0.1, 1.0),
+                            rng.range(0.1, 1.0),
+                        ));
+                    Shape::Sphere(Sphere::new(m))
+                } else {
+                    Shape::Triangle {
+                        p: [c + rng.vec(1.5), c + rng.vec(1.5), c + rng.vec(1.5)],
+                        normals: None,
+                    }
+                };
+                Primitive { shape, material: 0 }
+            })
+            .collect()
+    }
+
+    /// A regular grid of coplanar quads (two triangles each) in z = 0: every shared
+    /// edge is an opportunity for ties and leaks.
+    pub fn coplanar_grid(n: usize) -> Vec<Primitive> {
+        let mut prims = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let p = |a: usize, b: usize| Vec3A::new(a as f32, b as f32, 0.0);
+                prims.push(Primitive {
+                    shape: Shape::Triangle {
+                        p: [p(i, j), p(i + 1, j), p(i + 1, j + 1)],
+                        normals: None,
+                    },
+                    material: 0,
+                });
+                prims.push(Primitive {
+                    shape: Shape::Triangle {
+                        p: [p(i, j), p(i + 1, j + 1), p(i, j + 1)],
+                        normals: None,
+                    },
+                    material: 0,
+                });
+            }
+        }
+        prims
+    }
+}

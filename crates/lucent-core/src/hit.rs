@@ -1,0 +1,39 @@
+//! What traversal reports about the closest hit, and what shading needs from it.
+
+use crate::math::{Color, Vec3A};
+
+/// The closest hit found by an acceleration structure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    /// Index of the primitive in scene order.
+    pub prim: u32,
+    /// Barycentric weights of the second and third triangle vertex (0 for other shapes).
+    pub b1: f32,
+    pub b2: f32,
+}
+
+impl Hit {
+    /// The tie-breaking rule every acceleration structure shares, so that all of them
+    /// return the same hit as the brute-force list: the smaller `t` wins, and for equal
+    /// `t` the primitive that comes first in the scene.
+    #[inline(always)]
+    pub fn is_closer_than(t: f32, prim: u32, best: &Option<Hit>) -> bool {
+        match best {
+            None => true,
+            Some(b) => t < b.t || (t == b.t && prim < b.prim),
+        }
+    }
+}
+
+/// Everything shading needs about a surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    pub point: Vec3A,
+    /// Unit shading normal, as the scene defines it (never flipped toward the viewer).
+    pub normal: Vec3A,
+    pub material: u32,
+}
+
+/// Pixel value of a ray that hits nothing.
+pub const BACKGROUND: Color = Color::ZERO;

@@ -1,0 +1,22 @@
+//! lucent-core: everything that runs while a picture is made — geometry, acceleration
+//! structures, the camera, shading, the integrator and the tiled render loop.
+//!
+//! This crate does no file I/O and knows no scene format: `lucent-io` parses files into
+//! a description and builds a [`scene::Scene`] from it; this crate renders that scene.
+//! The path of one pixel can be read top-down in [`render`].
+
+pub mod aabb;
+pub mod accel;
+pub mod camera;
+pub mod film;
+pub mod hit;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod math;
+pub mod primitive;
+pub mod ray;
+pub mod render;
+pub mod scene;
+pub mod shape;
+pub mod transform;

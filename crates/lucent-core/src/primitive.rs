@@ -1,0 +1,153 @@
+//! The primitives a scene holds: what the acceleration structures bound and intersect,
+//! and what turns a hit into a surface point for shading.
+
+use crate::aabb::Aabb;
+use crate::hit::{Hit, SurfacePoint};
+use crate::math::{Affine3A, Mat3A, Vec3A};
+use crate::ray::PreparedRay;
+use crate::shape::{sphere, triangle};
+
+/// A sphere or ellipsoid: the unit sphere mapped by an affine object-to-world transform.
+#[derive(Clone, Copy, Debug)]
+pub struct Sphere {
+    pub world_to_object: Affine3A,
+    /// Inverse transpose of the object-to-world linear part: carries normals to world.
+    pub normal_to_world: Mat3A,
+    pub bounds: Aabb,
+}
+
+impl Sphere {
+    /// `object_to_world` maps the unit sphere at the origin onto the sphere.
+    pub fn new(object_to_world: Affine3A) -> Sphere {
+        let world_to_object = object_to_world.inverse();
+        // Exact bounds of an affinely mapped unit sphere: along world axis i the half
+        // extent is the length of row i of the linear part.
+        let m = object_to_world.matrix3;
+        let rows = m.transpose();
+        let half = Vec3A::new(
+            rows.x_axis.length(),
+            rows.y_axis.length(),
+            rows.z_axis.length(),
+        );
+        let c = object_to_world.translation;
+        Sphere {
+            world_to_object,
+            normal_to_world: world_to_object.matrix3.transpose(),
+            bounds: Aabb::new(c - half, c + half),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Shape {
+    /// World-space vertices; `normals` indexes the scene's per-vertex normals
+    /// (`trinormal`), `None` for the flat geometric normal (`tri`).
+    Triangle {
+        p: [Vec3A; 3],
+        normals: Option<u32>,
+    },
+    Sphere(Sphere),
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Primitive {
+    pub shape: Shape,
+    pub material: u32,
+}
+
+impl Primitive {
+    pub fn bounds(&self) -> Aabb {
+        match &self.shape {
+            Shape::Triangle { p, .. } => Aabb::from_points(p),
+            Shape::Sphere(s) => s.bounds,
+        }
+    }
+
+    /// The hit of `ray` with this primitive in `(t_min, t_max]`, as
+    /// `(t, b1, b2)` (barycentrics are 0 for spheres).
+    #[inline(always)]
+    pub fn intersect(&self, ray: &PreparedRay, t_max: f32) -> Option<(f32, f32, f32)> {
+        match &self.shape {
+            Shape::Triangle { p, .. } => {
+                triangle::intersect(ray, p[0], p[1], p[2], t_max).map(|h| (h.t, h.b1, h.b2))
+            }
+            Shape::Sphere(s) => {
+                let o = s.world_to_object.transform_point3a(ray.ray.origin);
+                let d = s.world_to_object.transform_vector3a(ray.ray.dir);
+                sphere::intersect_unit_geometric(o, d, ray.ray.t_min, t_max).map(|t| (t, 0.0, 0.0))
+            }
+        }
+    }
+
+    /// Shading data at a hit of `origin + t·dir` on this primitive.
+    pub fn surface_point(
+        &self,
+        hit: &Hit,
+        origin: Vec3A,
+        dir: Vec3A,
+        vertex_normals: &[[Vec3A; 3]],
+    ) -> SurfacePoint {
+        let point = origin + dir * hit.t;
+        let normal = match &self.shape {
+            Shape::Triangle { p, normals: None } => triangle::geometric_normal(p[0], p[1], p[2]),
+            Shape::Triangle {
+                normals: Some(i), ..
+            } => {
+                let n = &vertex_normals[*i as usize];
+                let b0 = 1.0 - hit.b1 - hit.b2;
+                (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize()
+            }
+            Shape::Sphere(s) => {
+                // The object-space hit point is the object-space normal of the unit sphere.
+                let o = s.world_to_object.transform_point3a(origin);
+                let d = s.world_to_object.transform_vector3a(dir);
+                (s.normal_to_world * (o + d * hit.t)).normalize()
+            }
+        };
+        SurfacePoint {
+            point,
+            normal,
+            material: self.material,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ray::Ray;
+
+    #[test]
+    fn ellipsoid_bounds_are_exact_and_normals_use_the_inverse_transpose() {
+        // Unit sphere scaled by (2, 1, 1) then rotated 90° about z: extends ±1 in x, ±2 in y.
+        let m = Affine3A::from_rotation_z(std::f32::consts::FRAC_PI_2)
+            * Affine3A::from_scale(glam::Vec3::new(2.0, 1.0, 1.0));
+        let s = Sphere::new(m);
+        assert!(
+            (s.bounds.max - Vec3A::new(1.0, 2.0, 1.0))
+                .abs()
+                .max_element()
+                < 1e-5
+        );
+        let prim = Primitive {
+            shape: Shape::Sphere(s),
+            material: 0,
+        };
+        // A ray down the z axis at (x=0.5, y=0) hits the ellipsoid x² + (y/2)² + z² = 1 at z = sqrt(0.75).
+        let ray = Ray::segment(Vec3A::new(0.5, 0.0, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY);
+        let (t, _, _) = prim
+            .intersect(&PreparedRay::new(ray), f32::INFINITY)
+            .unwrap();
+        assert!((t - (5.0 - 0.75f32.sqrt())).abs() < 1e-5);
+        let hit = Hit {
+            t,
+            prim: 0,
+            b1: 0.0,
+            b2: 0.0,
+        };
+        let sp = prim.surface_point(&hit, ray.origin, ray.dir, &[]);
+        // Gradient of x² + y²/4 + z² is (2x, y/2, 2z) ∝ (x, y/4, z).
+        let expect = Vec3A::new(0.5, 0.0, 0.75f32.sqrt()).normalize();
+        assert!((sp.normal - expect).length() < 1e-5, "{}", sp.normal);
+    }
+}

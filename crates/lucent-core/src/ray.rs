@@ -1,0 +1,100 @@
+//! Rays, and the per-ray data that traversal precomputes once.
+
+use crate::math::{max_abs_axis, Vec3A};
+use glam::BVec3A;
+
+/// The distance a secondary ray skips to avoid hitting the surface it leaves
+/// (SCENE_FORMAT.md §4.2: world units, unit-length directions).
+pub const EPSILON: f32 = 1e-4;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub origin: Vec3A,
+    /// Unit length for every ray the renderer traces.
+    pub dir: Vec3A,
+    /// Hits count only for `t_min < t <= t_max`.
+    pub t_min: f32,
+    pub t_max: f32,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3A, dir: Vec3A) -> Ray {
+        Ray {
+            origin,
+            dir,
+            t_min: EPSILON,
+            t_max: f32::INFINITY,
+        }
+    }
+
+    pub fn segment(origin: Vec3A, dir: Vec3A, t_min: f32, t_max: f32) -> Ray {
+        Ray {
+            origin,
+            dir,
+            t_min,
+            t_max,
+        }
+    }
+
+    pub fn at(&self, t: f32) -> Vec3A {
+        self.origin + self.dir * t
+    }
+}
+
+/// A ray with what every box and triangle test needs, computed once per ray: the
+/// reciprocal direction for slab tests and the shear of the watertight triangle test
+/// (Woop, Benthin & Wald 2013).
+#[derive(Clone, Copy, Debug)]
+pub struct PreparedRay {
+    pub ray: Ray,
+    /// `1/dir`, with zero components replaced by `+f32::MAX` so that `0 · inv` is never
+    /// NaN in a slab test (the sign of a zero must not matter: a ray that does not move
+    /// along an axis is inside that slab exactly when its origin is).
+    pub inv_dir: Vec3A,
+    /// The axes along which the ray does not move (`dir` component ±0).
+    pub zero_axes: BVec3A,
+    /// Axis permutation: `kz` is the dominant axis of the direction.
+    pub kx: usize,
+    pub ky: usize,
+    pub kz: usize,
+    /// Shear constants that map the ray to +z.
+    pub sx: f32,
+    pub sy: f32,
+    pub sz: f32,
+}
+
+impl PreparedRay {
+    pub fn new(ray: Ray) -> PreparedRay {
+        let d = ray.dir;
+        let inv = |c: f32| {
+            let r = 1.0 / c;
+            if r.is_finite() {
+                r
+            } else if c == 0.0 {
+                f32::MAX
+            } else {
+                f32::MAX.copysign(c)
+            }
+        };
+        let inv_dir = Vec3A::new(inv(d.x), inv(d.y), inv(d.z));
+        let kz = max_abs_axis(d);
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        let dz = d[kz];
+        // Keep the winding of the projected triangle: swap when looking down -z.
+        if dz < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        PreparedRay {
+            ray,
+            inv_dir,
+            zero_axes: d.cmpeq(Vec3A::ZERO),
+            kx,
+            ky,
+            kz,
+            sx: d[kx] / dz,
+            sy: d[ky] / dz,
+            sz: 1.0 / dz,
+        }
+    }
+}

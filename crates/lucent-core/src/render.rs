@@ -1,0 +1,109 @@
+//! The render loop: the image is cut into square tiles, rayon spreads the tiles over the
+//! threads of the current pool, and each pixel's value depends only on the pixel, never
+//! on which thread or in which order its tile ran — so the output is the same bytes for
+//! any thread count.
+//!
+//! The path of one pixel: [`render`] → `render_tile` → [`Camera::ray`] through the pixel
+//! centre → [`Integrator::radiance`] → the film.
+//!
+//! [`Camera::ray`]: crate::camera::Camera::ray
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rayon::prelude::*;
+
+use crate::film::Film;
+use crate::integrator::Integrator;
+use crate::math::Color;
+use crate::scene::Scene;
+
+pub const TILE_SIZE: u32 = 16;
+
+/// What the render loop reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RenderStats {
+    /// Every ray traced: camera, shadow and reflection rays.
+    pub rays: u64,
+    /// Samples that came out NaN or infinite and were replaced by black.
+    pub bad_samples: u64,
+}
+
+/// Hooks for the caller: `progress` is called after each tile with the number of pixels
+/// it finished; when `cancel` becomes true the remaining tiles are skipped.
+pub struct RenderControl<'a> {
+    pub progress: &'a (dyn Fn(u64) + Sync),
+    pub cancel: &'a AtomicBool,
+}
+
+struct Tile {
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+}
+
+/// Renders `scene` with `integrator` on the current rayon pool. `None` if cancelled.
+pub fn render(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    control: &RenderControl,
+) -> Option<(Film, RenderStats)> {
+    let (w, h) = (scene.width, scene.height);
+    let tiles: Vec<Tile> = (0..h.div_ceil(TILE_SIZE))
+        .flat_map(|ty| {
+            (0..w.div_ceil(TILE_SIZE)).map(move |tx| Tile {
+                x0: tx * TILE_SIZE,
+                y0: ty * TILE_SIZE,
+                x1: ((tx + 1) * TILE_SIZE).min(w),
+                y1: ((ty + 1) * TILE_SIZE).min(h),
+            })
+        })
+        .collect();
+
+    let results: Vec<Option<(Vec<Color>, RenderStats)>> = tiles
+        .par_iter()
+        .map(|tile| {
+            if control.cancel.load(Ordering::Relaxed) {
+                return None;
+            }
+            let out = render_tile(scene, integrator, tile);
+            (control.progress)(out.0.len() as u64);
+            Some(out)
+        })
+        .collect();
+
+    let mut film = Film::new(w, h);
+    let mut stats = RenderStats::default();
+    for (tile, result) in tiles.iter().zip(results) {
+        let (pixels, s) = result?;
+        stats.rays += s.rays;
+        stats.bad_samples += s.bad_samples;
+        let tw = (tile.x1 - tile.x0) as usize;
+        for (row, chunk) in pixels.chunks(tw).enumerate() {
+            let start = (tile.y0 as usize + row) * w as usize + tile.x0 as usize;
+            film.pixels[start..start + tw].copy_from_slice(chunk);
+        }
+    }
+    Some((film, stats))
+}
+
+fn render_tile(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    tile: &Tile,
+) -> (Vec<Color>, RenderStats) {
+    let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
+    let mut stats = RenderStats::default();
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            let ray = scene.camera.ray(x as f64 + 0.5, y as f64 + 0.5);
+            let mut c = integrator.radiance(scene, &ray, &mut stats.rays);
+            if !c.is_finite() {
+                stats.bad_samples += 1;
+                c = Color::ZERO;
+            }
+            pixels.push(c);
+        }
+    }
+    (pixels, stats)
+}

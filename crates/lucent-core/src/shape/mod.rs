@@ -1,0 +1,7 @@
+//! Ray–shape intersection routines, one file per shape. Each works on plain geometry
+//! and is tested against analytic answers; [`crate::primitive`] wraps them as the
+//! primitives a scene holds.
+
+pub mod plane;
+pub mod sphere;
+pub mod triangle;
