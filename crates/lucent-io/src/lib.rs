@@ -1,1 +1,13 @@
+//! lucent-io: scene formats in, images out.
+//!
+//! The flow is parse → description → build: [`cse167::parse_file`] records what a scene
+//! file says, with the `file:line:col` of every command, into a plain [`desc::SceneDesc`];
+//! [`build::build`] turns that into a renderable [`lucent_core::scene::Scene`]. Problems
+//! found on the way are [`diag::Diagnostic`]s that point at the offending token.
 
+pub mod build;
+pub mod cse167;
+pub mod desc;
+pub mod diag;
+pub mod image;
+mod number;

@@ -1,1 +1,46 @@
-fn main() {}
+//! `lucent`: the command line. `render` makes a picture of a scene, `check` validates one
+//! and says what it holds, `diff` compares two images.
+
+mod check;
+mod diff;
+mod output;
+mod progress;
+mod render;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Exit code for bad input, missing files and unwritable output.
+pub const EXIT_BAD_INPUT: u8 = 2;
+
+#[derive(Parser)]
+#[command(
+    name = "lucent",
+    version,
+    about = "A CPU ray tracer for the CSE167/CSE168 scene format"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image.
+    Render(render::RenderArgs),
+    /// Parse and validate a scene without rendering it, and print what it holds.
+    Check(check::CheckArgs),
+    /// Compare two images (PNG or JPEG) pixel by pixel.
+    Diff(diff::DiffArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let code = match cli.command {
+        Command::Render(a) => render::run(&a),
+        Command::Check(a) => check::run(&a),
+        Command::Diff(a) => diff::run(&a),
+    };
+    ExitCode::from(code)
+}

@@ -1,0 +1,206 @@
+//! The build step: a [`SceneDesc`] becomes a renderable [`Scene`] — world-space
+//! triangles, spheres as transformed unit spheres, lights, materials, the camera and the
+//! acceleration structure. This is the only module that knows both the description and
+//! the core. It reports what the description cannot be rendered as (unsupported
+//! features, degenerate geometry) at the location of the command responsible.
+
+use glam::{DAffine3, DVec3};
+use lucent_core::accel::AccelKind;
+use lucent_core::camera::Camera;
+use lucent_core::integrator::whitted::Whitted;
+use lucent_core::integrator::Integrator;
+use lucent_core::light::Light;
+use lucent_core::math::Vec3A;
+use lucent_core::primitive::{Primitive, Shape, Sphere};
+use lucent_core::scene::{Scene, SceneParts};
+use lucent_core::transform::Transform;
+
+use crate::desc::*;
+use crate::diag::Diagnostics;
+
+/// `maxdepth -1` (unbounded) is capped here: a closed mirror box would never end.
+pub const UNBOUNDED_DEPTH_CAP: u32 = 100;
+
+#[derive(Clone, Copy, Debug)]
+pub struct BuildOptions {
+    pub accel: AccelKind,
+}
+
+impl Default for BuildOptions {
+    fn default() -> Self {
+        BuildOptions {
+            accel: AccelKind::Bvh,
+        }
+    }
+}
+
+pub struct Built {
+    pub scene: Scene,
+    pub integrator: Box<dyn Integrator>,
+    /// Output encoding exponent (`gamma`, 1 = none).
+    pub gamma: f32,
+}
+
+/// Builds the scene, or returns `None` after adding errors to `diags`.
+pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) -> Option<Built> {
+    let errors_before = diags.count(crate::diag::Severity::Error);
+    check_settings(desc, diags);
+    let (Some(size), Some(cam)) = (&desc.size, &desc.camera) else {
+        return None; // the parser has reported it
+    };
+    let (width, height) = size.value;
+    let c = cam.value;
+    let camera = Camera::look_at(c.eye, c.center, c.up, c.fovy, width, height).ok()?;
+
+    let max_depth = match desc.max_depth() {
+        -1 => {
+            let loc = desc.max_depth.as_ref().map(|d| d.loc).unwrap_or(desc.end);
+            diags.warning(
+                loc,
+                format!("maxdepth: -1 (unbounded) is capped at {UNBOUNDED_DEPTH_CAP} bounces"),
+            );
+            UNBOUNDED_DEPTH_CAP
+        }
+        d => d as u32,
+    };
+
+    let mut primitives = Vec::with_capacity(desc.shapes.len());
+    let mut vertex_normals = Vec::new();
+    for s in &desc.shapes {
+        let t = &desc.transforms[s.transform as usize];
+        let shape = match s.kind {
+            ShapeKind::Sphere { center, radius } => {
+                let m = t.m
+                    * DAffine3::from_translation(center)
+                    * DAffine3::from_scale(DVec3::splat(radius));
+                Shape::Sphere(Sphere::new(Transform::to_f32(&m)))
+            }
+            ShapeKind::Triangle { v } => {
+                let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
+                Shape::Triangle { p, normals: None }
+            }
+            ShapeKind::TriNormal { v } => {
+                let p = v.map(|i| to_f32(t.point(desc.vertex_normals[i as usize].0)));
+                let n = v.map(|i| to_f32(t.normal(desc.vertex_normals[i as usize].1).normalize()));
+                vertex_normals.push(n);
+                Shape::Triangle {
+                    p,
+                    normals: Some(vertex_normals.len() as u32 - 1),
+                }
+            }
+        };
+        if let Shape::Triangle { p, normals } = &shape {
+            let n = (p[1] - p[0]).cross(p[2] - p[0]);
+            if !(n.length_squared() > 0.0) || !n.is_finite() {
+                diags.warning(s.loc, "degenerate triangle (zero area) skipped");
+                if normals.is_some() {
+                    vertex_normals.pop();
+                }
+                continue;
+            }
+        }
+        primitives.push(Primitive {
+            shape,
+            material: s.material,
+        });
+    }
+
+    let mut lights = Vec::new();
+    for l in &desc.lights {
+        let t = &desc.transforms[l.transform as usize];
+        match l.kind {
+            LightKind::Directional { dir, color } => lights.push(Light::Directional {
+                direction: to_f32(t.vector(dir).normalize()),
+                color: to_f32(color),
+            }),
+            LightKind::Point {
+                position,
+                color,
+                attenuation,
+            } => lights.push(Light::Point {
+                position: to_f32(t.point(position)),
+                color: to_f32(color),
+                attenuation: to_f32(attenuation),
+            }),
+            LightKind::Quad { .. } => {
+                diags.error(
+                    l.loc,
+                    "quadLight: area lights are not implemented yet in the raytracer integrator",
+                );
+            }
+        }
+    }
+
+    if diags.count(crate::diag::Severity::Error) > errors_before || diags.has_errors() {
+        return None;
+    }
+    let materials = desc.materials.iter().map(|m| m.base).collect();
+    let parts = SceneParts {
+        width,
+        height,
+        camera,
+        primitives,
+        materials,
+        lights,
+        vertex_normals,
+    };
+    Some(Built {
+        scene: Scene::new(parts, options.accel),
+        integrator: Box::new(Whitted { max_depth }),
+        gamma: desc.gamma() as f32,
+    })
+}
+
+/// Global settings this version cannot honour are errors; settings that only other
+/// integrators read are warnings.
+fn check_settings(desc: &SceneDesc, diags: &mut Diagnostics) {
+    if let Some(i) = &desc.integrator {
+        if i.value != IntegratorKind::RayTracer {
+            diags.error(
+                i.loc,
+                format!(
+                    "integrator: '{}' is not implemented yet (this version renders 'raytracer')",
+                    i.value.name()
+                ),
+            );
+            return;
+        }
+    }
+    if let Some(s) = &desc.spp {
+        if s.value > 1 {
+            diags.error(
+                s.loc,
+                "spp: antialiasing (more than 1 sample per pixel) is not implemented yet",
+            );
+        }
+    }
+    let only_for = |name: &str, loc, diags: &mut Diagnostics| {
+        diags.warning(
+            loc,
+            format!("{name}: has no effect with integrator raytracer"),
+        );
+    };
+    if let Some(v) = &desc.next_event_estimation {
+        only_for("nexteventestimation", v.loc, diags);
+    }
+    if let Some(v) = &desc.russian_roulette {
+        only_for("russianroulette", v.loc, diags);
+    }
+    if let Some(v) = &desc.importance_sampling {
+        only_for("importancesampling", v.loc, diags);
+    }
+    if let Some(s) = desc
+        .shapes
+        .iter()
+        .find(|s| desc.materials[s.material as usize].brdf == Brdf::Ggx)
+    {
+        diags.warning(
+            s.loc,
+            "brdf ggx has no effect with integrator raytracer (it shades with Blinn-Phong)",
+        );
+    }
+}
+
+fn to_f32(v: DVec3) -> Vec3A {
+    Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
+}

@@ -1,0 +1,178 @@
+//! The scene description: plain data recording what a scene file says, with the location
+//! of every command. The parser fills it; [`crate::build`] turns it into a renderable
+//! scene. Nothing here is specific to one file format.
+
+use glam::DVec3;
+use lucent_core::material::Material;
+use lucent_core::transform::Transform;
+
+use crate::diag::{Loc, SourceMap};
+
+/// A value and where the file gave it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Located<T> {
+    pub value: T,
+    pub loc: Loc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraDesc {
+    pub eye: DVec3,
+    pub center: DVec3,
+    pub up: DVec3,
+    pub fovy: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorKind {
+    RayTracer,
+    AnalyticDirect,
+    Direct,
+    PathTracer,
+}
+
+impl IntegratorKind {
+    pub const ALL: [(&'static str, IntegratorKind); 4] = [
+        ("raytracer", IntegratorKind::RayTracer),
+        ("analyticdirect", IntegratorKind::AnalyticDirect),
+        ("direct", IntegratorKind::Direct),
+        ("pathtracer", IntegratorKind::PathTracer),
+    ];
+
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, k)| *k == self)
+            .map_or("?", |(n, _)| n)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Brdf {
+    Phong,
+    Ggx,
+}
+
+/// The current material as objects capture it: the Whitted terms plus the CSE168 BRDF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MaterialDesc {
+    pub base: Material,
+    pub brdf: Brdf,
+    pub roughness: f64,
+}
+
+impl Default for MaterialDesc {
+    fn default() -> Self {
+        MaterialDesc {
+            base: Material::default(),
+            brdf: Brdf::Phong,
+            roughness: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShapeKind {
+    /// Centre and radius in object space.
+    Sphere { center: DVec3, radius: f64 },
+    /// Indices into [`SceneDesc::vertices`].
+    Triangle { v: [u32; 3] },
+    /// Indices into [`SceneDesc::vertex_normals`].
+    TriNormal { v: [u32; 3] },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeDesc {
+    pub kind: ShapeKind,
+    /// Index into [`SceneDesc::transforms`]: the transform current at the command.
+    pub transform: u32,
+    /// Index into [`SceneDesc::materials`]: the material current at the command.
+    pub material: u32,
+    pub loc: Loc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// `dir` points toward the light.
+    Directional { dir: DVec3, color: DVec3 },
+    Point {
+        position: DVec3,
+        color: DVec3,
+        attenuation: DVec3,
+    },
+    Quad {
+        a: DVec3,
+        ab: DVec3,
+        ac: DVec3,
+        color: DVec3,
+    },
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightDesc {
+    pub kind: LightKind,
+    pub transform: u32,
+    pub loc: Loc,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NeeMode {
+    Off,
+    On,
+    Mis,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectionSampling {
+    Hemisphere,
+    Cosine,
+    Brdf,
+}
+
+/// Everything a scene file says.
+#[derive(Clone, Debug, Default)]
+pub struct SceneDesc {
+    pub sources: SourceMap,
+    /// Where the description ends (for "missing command" errors).
+    pub end: Loc,
+
+    pub size: Option<Located<(u32, u32)>>,
+    pub camera: Option<Located<CameraDesc>>,
+    pub output: Option<Located<String>>,
+    pub max_depth: Option<Located<i32>>,
+    pub integrator: Option<Located<IntegratorKind>>,
+    pub spp: Option<Located<u32>>,
+    pub light_samples: Option<Located<u32>>,
+    pub light_stratify: Option<Located<bool>>,
+    pub next_event_estimation: Option<Located<NeeMode>>,
+    pub russian_roulette: Option<Located<bool>>,
+    pub importance_sampling: Option<Located<DirectionSampling>>,
+    pub gamma: Option<Located<f64>>,
+
+    /// The `vertex` pile, untransformed.
+    pub vertices: Vec<DVec3>,
+    /// The `vertexnormal` pile: position and normal, untransformed.
+    pub vertex_normals: Vec<(DVec3, DVec3)>,
+    /// Transforms captured by shapes and lights (deduplicated while parsing).
+    pub transforms: Vec<Transform>,
+    /// Materials captured by shapes (deduplicated while parsing).
+    pub materials: Vec<MaterialDesc>,
+    pub shapes: Vec<ShapeDesc>,
+    pub lights: Vec<LightDesc>,
+}
+
+impl SceneDesc {
+    pub fn max_depth(&self) -> i32 {
+        self.max_depth.as_ref().map_or(5, |d| d.value)
+    }
+
+    pub fn integrator(&self) -> IntegratorKind {
+        self.integrator
+            .as_ref()
+            .map_or(IntegratorKind::RayTracer, |i| i.value)
+    }
+
+    pub fn gamma(&self) -> f64 {
+        self.gamma.as_ref().map_or(1.0, |g| g.value)
+    }
+}

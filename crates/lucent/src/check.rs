@@ -1,0 +1,90 @@
+//! `lucent check SCENE`: parse and validate without rendering, then print what the scene
+//! holds. Errors are reported exactly as `render` reports them.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use lucent_core::accel::AccelKind;
+use lucent_io::build::{build, BuildOptions};
+use lucent_io::cse167::{parse_file, ParseOptions};
+use lucent_io::desc::{LightKind, ShapeKind};
+
+use crate::output::report;
+use crate::EXIT_BAD_INPUT;
+
+#[derive(Args)]
+pub struct CheckArgs {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Treat unknown commands as errors.
+    #[arg(long)]
+    pub strict: bool,
+}
+
+pub fn run(args: &CheckArgs) -> u8 {
+    let (desc, mut diags) = parse_file(
+        &args.scene,
+        ParseOptions {
+            strict: args.strict,
+        },
+    );
+    // The list needs no build time and reports the same problems as the BVH.
+    let built = if diags.has_errors() {
+        None
+    } else {
+        build(
+            &desc,
+            &BuildOptions {
+                accel: AccelKind::List,
+            },
+            &mut diags,
+        )
+    };
+    report(&diags, &desc.sources);
+    let Some(built) = built else {
+        return EXIT_BAD_INPUT;
+    };
+
+    let count = |f: &dyn Fn(&ShapeKind) -> bool| desc.shapes.iter().filter(|s| f(&s.kind)).count();
+    let spheres = count(&|k| matches!(k, ShapeKind::Sphere { .. }));
+    let tris = count(&|k| matches!(k, ShapeKind::Triangle { .. }));
+    let trinormals = count(&|k| matches!(k, ShapeKind::TriNormal { .. }));
+    let lights = |f: &dyn Fn(&LightKind) -> bool| desc.lights.iter().filter(|l| f(&l.kind)).count();
+    let (w, h) = desc.size.as_ref().map(|s| s.value).unwrap_or_default();
+    let c = desc.camera.as_ref().expect("checked by the parser").value;
+    let v = |v: lucent_core::math::DVec3| format!("({}, {}, {})", v.x, v.y, v.z);
+
+    println!("scene:      {}", args.scene.display());
+    println!("size:       {w} x {h}");
+    println!(
+        "output:     {}",
+        desc.output
+            .as_ref()
+            .map_or("raytrace.png (default)", |o| o.value.as_str())
+    );
+    println!(
+        "camera:     eye {} look-at {} up {} fovy {}",
+        v(c.eye),
+        v(c.center),
+        v(c.up),
+        c.fovy
+    );
+    println!(
+        "integrator: {}, maxdepth {}",
+        desc.integrator().name(),
+        desc.max_depth()
+    );
+    println!(
+        "objects:    {spheres} spheres, {} triangles ({trinormals} with vertex normals)",
+        tris + trinormals
+    );
+    println!("primitives: {} after build", built.scene.primitives.len());
+    println!(
+        "lights:     {} point, {} directional, {} quad",
+        lights(&|k| matches!(k, LightKind::Point { .. })),
+        lights(&|k| matches!(k, LightKind::Directional { .. })),
+        lights(&|k| matches!(k, LightKind::Quad { .. }))
+    );
+    println!("materials:  {}", desc.materials.len());
+    0
+}

@@ -1,0 +1,53 @@
+//! `lucent diff A B`: how two images differ — pixels differing by more than a threshold in
+//! any channel, and the mean absolute error on the 0–255 scale. With `--max-pixels` or
+//! `--max-mae` it exits with 1 when the difference is larger (for scripts).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use lucent_io::image::{diff, read_rgb8};
+
+use crate::EXIT_BAD_INPUT;
+
+#[derive(Args)]
+pub struct DiffArgs {
+    pub a: PathBuf,
+    pub b: PathBuf,
+    /// A pixel differs when a channel differs by more than this (0–255).
+    #[arg(long, default_value_t = 2)]
+    pub threshold: u8,
+    /// Fail when more pixels than this differ.
+    #[arg(long)]
+    pub max_pixels: Option<usize>,
+    /// Fail when the mean absolute error is this or more.
+    #[arg(long)]
+    pub max_mae: Option<f64>,
+}
+
+pub fn run(args: &DiffArgs) -> u8 {
+    let (a, b) = match (read_rgb8(&args.a), read_rgb8(&args.b)) {
+        (Ok(a), Ok(b)) => (a, b),
+        (Err(e), _) | (_, Err(e)) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let Some(d) = diff(&a, &b, args.threshold) else {
+        eprintln!(
+            "lucent: error: the images differ in size: {}x{} and {}x{}",
+            a.width, a.height, b.width, b.height
+        );
+        return EXIT_BAD_INPUT;
+    };
+    println!(
+        "pixels_over={} pixels={} threshold={} mae={:.4} max={}",
+        d.pixels_over, d.pixels, args.threshold, d.mean_abs_error, d.max_abs_error
+    );
+    let too_many = args.max_pixels.is_some_and(|m| d.pixels_over > m);
+    let too_far = args.max_mae.is_some_and(|m| d.mean_abs_error >= m);
+    if too_many || too_far {
+        1
+    } else {
+        0
+    }
+}

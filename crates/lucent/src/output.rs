@@ -1,0 +1,48 @@
+//! Where the image goes, and how diagnostics are printed.
+
+use std::path::{Path, PathBuf};
+
+use lucent_io::desc::SceneDesc;
+use lucent_io::diag::{Diagnostics, Loc, SourceMap};
+
+/// The output file: `-o`, else the scene's `output` command (relative to the current
+/// directory, SCENE_FORMAT.md §3.1), else `raytrace.png`. Only PNG is written by this
+/// version; a name with another extension gets PNG and a warning, `.exr` is refused.
+pub fn choose_output(
+    cli: Option<&Path>,
+    desc: &SceneDesc,
+    diags: &mut Diagnostics,
+) -> Result<PathBuf, String> {
+    let (path, loc): (PathBuf, Option<Loc>) = match (cli, &desc.output) {
+        (Some(p), _) => (p.to_path_buf(), None),
+        (None, Some(o)) => (PathBuf::from(&o.value), Some(o.loc)),
+        (None, None) => (PathBuf::from("raytrace.png"), None),
+    };
+    let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase());
+    match ext.as_deref() {
+        Some("png") => Ok(path),
+        Some("exr") => Err(format!(
+            "{}: EXR output is not implemented yet; use a .png name",
+            path.display()
+        )),
+        _ => {
+            let msg = format!(
+                "output: '{}' does not end in .png; writing PNG anyway",
+                path.display()
+            );
+            match loc {
+                Some(loc) => diags.warning(loc, msg),
+                None => eprintln!("lucent: warning: {msg}"),
+            }
+            Ok(path)
+        }
+    }
+}
+
+/// Prints every diagnostic to stderr.
+pub fn report(diags: &Diagnostics, sources: &SourceMap) {
+    let text = diags.render(sources);
+    if !text.is_empty() {
+        eprint!("{text}");
+    }
+}

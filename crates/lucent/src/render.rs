@@ -1,0 +1,148 @@
+//! `lucent render SCENE [-o OUT.png] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use clap::Args;
+use lucent_core::accel::AccelKind;
+use lucent_core::render::{render, RenderControl};
+use lucent_io::build::{build, BuildOptions};
+use lucent_io::cse167::{parse_file, ParseOptions};
+use lucent_io::diag::Diagnostics;
+use lucent_io::image::{check_writable, write_png};
+
+use crate::output::{choose_output, report};
+use crate::progress::Progress;
+use crate::EXIT_BAD_INPUT;
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// The scene file (CSE167/CSE168 format).
+    pub scene: PathBuf,
+    /// Output image; default: the scene's `output` command, else raytrace.png.
+    #[arg(short, long, value_name = "OUT.png")]
+    pub output: Option<PathBuf>,
+    /// Worker threads (default: all cores). The image is the same for any count.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Acceleration structure.
+    #[arg(long, default_value = "bvh", value_parser = ["bvh", "list"])]
+    pub accel: String,
+    /// Treat unknown commands as errors.
+    #[arg(long)]
+    pub strict: bool,
+    /// No progress bar and no summary line (warnings and errors are still printed).
+    #[arg(short, long)]
+    pub quiet: bool,
+    /// Print the time of each phase (parse, build, render, write).
+    #[arg(long)]
+    pub stats: bool,
+}
+
+pub fn run(args: &RenderArgs) -> u8 {
+    let accel: AccelKind = args.accel.parse().expect("clap checked the value");
+    let t_start = Instant::now();
+    let (desc, mut diags) = parse_file(
+        &args.scene,
+        ParseOptions {
+            strict: args.strict,
+        },
+    );
+    let t_parsed = Instant::now();
+    if diags.has_errors() {
+        report(&diags, &desc.sources);
+        return EXIT_BAD_INPUT;
+    }
+
+    let out = match choose_output(args.output.as_deref(), &desc, &mut diags) {
+        Ok(out) => out,
+        Err(msg) => {
+            report(&diags, &desc.sources);
+            eprintln!("lucent: error: {msg}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    if let Err(e) = check_writable(&out) {
+        report(&diags, &desc.sources);
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
+    }
+
+    let t_build = Instant::now();
+    let built = build(&desc, &BuildOptions { accel }, &mut diags);
+    let t_built = Instant::now();
+    report(&diags, &desc.sources);
+    let Some(built) = built else {
+        return EXIT_BAD_INPUT;
+    };
+    diags = Diagnostics::default();
+
+    let pool = match rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+    {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("lucent: error: cannot start worker threads: {e}");
+            return 1;
+        }
+    };
+    let scene = &built.scene;
+    let pixels = scene.width as u64 * scene.height as u64;
+    let progress = Progress::new(pixels, args.quiet);
+    let cancel = AtomicBool::new(false);
+    let on_progress = |n: u64| progress.advance(n);
+    let control = RenderControl {
+        progress: &on_progress,
+        cancel: &cancel,
+    };
+    let t_render = Instant::now();
+    let (film, stats) = pool
+        .install(|| render(scene, built.integrator.as_ref(), &control))
+        .expect("never cancelled");
+    let t_rendered = Instant::now();
+    progress.finish();
+
+    if stats.bad_samples > 0 {
+        eprintln!(
+            "lucent: warning: {} samples were NaN or infinite and were replaced by black",
+            stats.bad_samples
+        );
+    }
+    let rgb = film.to_rgb8(built.gamma);
+    if let Err(e) = write_png(&out, film.width, film.height, &rgb) {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
+    }
+    let t_written = Instant::now();
+    drop(diags);
+
+    let render_s = (t_rendered - t_render).as_secs_f64();
+    if !args.quiet {
+        eprintln!(
+            "{}x{}, {} primitives, {} rays, {:.3} s, {:.2} Mrays/s -> {}",
+            scene.width,
+            scene.height,
+            scene.primitives.len(),
+            stats.rays,
+            render_s,
+            stats.rays as f64 / render_s.max(1e-9) / 1e6,
+            out.display()
+        );
+    }
+    if args.stats {
+        eprintln!(
+            "parse {:.3} s, build {:.3} s ({} {:.1} MB), render {:.3} s on {} threads, write {:.3} s, total {:.3} s",
+            (t_parsed - t_start).as_secs_f64(),
+            (t_built - t_build).as_secs_f64(),
+            scene.accel_kind().name(),
+            scene.accel_memory_bytes() as f64 / 1e6,
+            render_s,
+            pool.current_num_threads(),
+            (t_written - t_rendered).as_secs_f64(),
+            (t_written - t_start).as_secs_f64(),
+        );
+    }
+    0
+}
