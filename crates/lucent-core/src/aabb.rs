@@ -110,10 +110,7 @@ mod tests {
     }
 
     fn slab(b: &Aabb, o: Vec3A, d: Vec3A) -> Option<(f32, f32)> {
-        b.intersect(
-            &PreparedRay::new(Ray::segment(o, d, 0.0, f32::INFINITY)),
-            f32::INFINITY,
-        )
+        b.intersect(&PreparedRay::new(Ray::segment(o, d, 0.0, f32::INFINITY)), f32::INFINITY)
     }
 
     #[test]
@@ -144,12 +141,7 @@ mod tests {
         // The ray runs inside the plane x = 1 of the box's face: 0·inv must not be NaN.
         assert!(slab(&unit_box(), Vec3A::new(1.0, 0.0, -5.0), Vec3A::Z).is_some());
         assert!(slab(&unit_box(), Vec3A::new(1.0001, 0.0, -5.0), Vec3A::Z).is_none());
-        assert!(slab(
-            &unit_box(),
-            Vec3A::new(-1.0, 1.0, -5.0),
-            Vec3A::new(-0.0, 0.0, 1.0)
-        )
-        .is_some());
+        assert!(slab(&unit_box(), Vec3A::new(-1.0, 1.0, -5.0), Vec3A::new(-0.0, 0.0, 1.0)).is_some());
         // A flat box (zero thickness) is still hit.
         let flat = Aabb::new(Vec3A::new(-1.0, 0.0, -1.0), Vec3A::new(1.0, 0.0, 1.0));
         assert!(slab(&flat, Vec3A::new(0.0, 5.0, 0.0), -Vec3A::Y).is_some());

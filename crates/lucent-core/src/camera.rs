@@ -78,15 +78,7 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_at_the_target_and_corners_span_the_fov() {
-        let c = Camera::look_at(
-            DVec3::new(0.0, 0.0, 5.0),
-            DVec3::ZERO,
-            DVec3::Y,
-            90.0,
-            200,
-            100,
-        )
-        .unwrap();
+        let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 90.0, 200, 100).unwrap();
         let r = c.ray(100.0, 50.0);
         assert!((r.dir - Vec3A::new(0.0, 0.0, -1.0)).length() < 1e-7);
         // Top edge at 45°; right edge at atan(2) because tan(fovx/2) = tan(fovy/2)·W/H.
@@ -113,20 +105,10 @@ mod tests {
 
     #[test]
     fn degenerate_cameras_are_refused() {
-        let bad =
-            |e: DVec3, c: DVec3, u: DVec3, f: f64| Camera::look_at(e, c, u, f, 10, 10).unwrap_err();
-        assert_eq!(
-            bad(DVec3::Z, DVec3::ZERO, DVec3::Y, 0.0),
-            CameraError::FovOutOfRange
-        );
-        assert_eq!(
-            bad(DVec3::Z, DVec3::ZERO, DVec3::Y, 180.0),
-            CameraError::FovOutOfRange
-        );
-        assert_eq!(
-            bad(DVec3::Z, DVec3::Z, DVec3::Y, 45.0),
-            CameraError::EyeAtTarget
-        );
+        let bad = |e: DVec3, c: DVec3, u: DVec3, f: f64| Camera::look_at(e, c, u, f, 10, 10).unwrap_err();
+        assert_eq!(bad(DVec3::Z, DVec3::ZERO, DVec3::Y, 0.0), CameraError::FovOutOfRange);
+        assert_eq!(bad(DVec3::Z, DVec3::ZERO, DVec3::Y, 180.0), CameraError::FovOutOfRange);
+        assert_eq!(bad(DVec3::Z, DVec3::Z, DVec3::Y, 45.0), CameraError::EyeAtTarget);
         assert_eq!(
             bad(DVec3::Z, DVec3::ZERO, DVec3::new(0.0, 0.0, 3.0), 45.0),
             CameraError::UpParallelToView

@@ -24,11 +24,7 @@ impl Sphere {
         // extent is the length of row i of the linear part.
         let m = object_to_world.matrix3;
         let rows = m.transpose();
-        let half = Vec3A::new(
-            rows.x_axis.length(),
-            rows.y_axis.length(),
-            rows.z_axis.length(),
-        );
+        let half = Vec3A::new(rows.x_axis.length(), rows.y_axis.length(), rows.z_axis.length());
         let c = object_to_world.translation;
         Sphere {
             world_to_object,
@@ -68,9 +64,7 @@ impl Primitive {
     #[inline(always)]
     pub fn intersect(&self, ray: &PreparedRay, t_max: f32) -> Option<(f32, f32, f32)> {
         match &self.shape {
-            Shape::Triangle { p, .. } => {
-                triangle::intersect(ray, p[0], p[1], p[2], t_max).map(|h| (h.t, h.b1, h.b2))
-            }
+            Shape::Triangle { p, .. } => triangle::intersect(ray, p[0], p[1], p[2], t_max).map(|h| (h.t, h.b1, h.b2)),
             Shape::Sphere(s) => {
                 let o = s.world_to_object.transform_point3a(ray.ray.origin);
                 let d = s.world_to_object.transform_vector3a(ray.ray.dir);
@@ -80,19 +74,11 @@ impl Primitive {
     }
 
     /// Shading data at a hit of `origin + t·dir` on this primitive.
-    pub fn surface_point(
-        &self,
-        hit: &Hit,
-        origin: Vec3A,
-        dir: Vec3A,
-        vertex_normals: &[[Vec3A; 3]],
-    ) -> SurfacePoint {
+    pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A, vertex_normals: &[[Vec3A; 3]]) -> SurfacePoint {
         let point = origin + dir * hit.t;
         let normal = match &self.shape {
             Shape::Triangle { p, normals: None } => triangle::geometric_normal(p[0], p[1], p[2]),
-            Shape::Triangle {
-                normals: Some(i), ..
-            } => {
+            Shape::Triangle { normals: Some(i), .. } => {
                 let n = &vertex_normals[*i as usize];
                 let b0 = 1.0 - hit.b1 - hit.b2;
                 (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize()
@@ -123,21 +109,14 @@ mod tests {
         let m = Affine3A::from_rotation_z(std::f32::consts::FRAC_PI_2)
             * Affine3A::from_scale(glam::Vec3::new(2.0, 1.0, 1.0));
         let s = Sphere::new(m);
-        assert!(
-            (s.bounds.max - Vec3A::new(1.0, 2.0, 1.0))
-                .abs()
-                .max_element()
-                < 1e-5
-        );
+        assert!((s.bounds.max - Vec3A::new(1.0, 2.0, 1.0)).abs().max_element() < 1e-5);
         let prim = Primitive {
             shape: Shape::Sphere(s),
             material: 0,
         };
         // A ray down the z axis at (x=0.5, y=0) hits the ellipsoid x² + (y/2)² + z² = 1 at z = sqrt(0.75).
         let ray = Ray::segment(Vec3A::new(0.5, 0.0, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY);
-        let (t, _, _) = prim
-            .intersect(&PreparedRay::new(ray), f32::INFINITY)
-            .unwrap();
+        let (t, _, _) = prim.intersect(&PreparedRay::new(ray), f32::INFINITY).unwrap();
         assert!((t - (5.0 - 0.75f32.sqrt())).abs() < 1e-5);
         let hit = Hit {
             t,

@@ -43,11 +43,7 @@ struct Tile {
 }
 
 /// Renders `scene` with `integrator` on the current rayon pool. `None` if cancelled.
-pub fn render(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    control: &RenderControl,
-) -> Option<(Film, RenderStats)> {
+pub fn render(scene: &Scene, integrator: &dyn Integrator, control: &RenderControl) -> Option<(Film, RenderStats)> {
     let (w, h) = (scene.width, scene.height);
     let tiles: Vec<Tile> = (0..h.div_ceil(TILE_SIZE))
         .flat_map(|ty| {
@@ -87,11 +83,7 @@ pub fn render(
     Some((film, stats))
 }
 
-fn render_tile(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    tile: &Tile,
-) -> (Vec<Color>, RenderStats) {
+fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<Color>, RenderStats) {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut stats = RenderStats::default();
     for y in tile.y0..tile.y1 {

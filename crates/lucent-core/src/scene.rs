@@ -69,12 +69,7 @@ impl Scene {
     }
 
     pub fn surface_point(&self, hit: &Hit, ray: &Ray) -> SurfacePoint {
-        self.primitives[hit.prim as usize].surface_point(
-            hit,
-            ray.origin,
-            ray.dir,
-            &self.vertex_normals,
-        )
+        self.primitives[hit.prim as usize].surface_point(hit, ray.origin, ray.dir, &self.vertex_normals)
     }
 
     pub fn accel_kind(&self) -> AccelKind {

@@ -116,14 +116,7 @@ impl Transform {
 
     /// The inverse transpose of the linear part, in `f32`, for normals.
     pub fn normal_matrix_f32(&self) -> Mat3A {
-        Mat3A::from_cols_array(
-            &self
-                .inv
-                .matrix3
-                .transpose()
-                .to_cols_array()
-                .map(|x| x as f32),
-        )
+        Mat3A::from_cols_array(&self.inv.matrix3.transpose().to_cols_array().map(|x| x as f32))
     }
 }
 
@@ -148,14 +141,8 @@ mod tests {
         let t = Transform::translate(DVec3::new(1.0, 0.0, 0.0));
         let s = Transform::scale(DVec3::splat(2.0)).unwrap();
         let m = t.then_apply(&s);
-        assert!(close(
-            m.point(DVec3::new(1.0, 0.0, 0.0)),
-            DVec3::new(3.0, 0.0, 0.0)
-        ));
-        assert!(close(
-            m.inv.transform_point3(DVec3::new(3.0, 0.0, 0.0)),
-            DVec3::X
-        ));
+        assert!(close(m.point(DVec3::new(1.0, 0.0, 0.0)), DVec3::new(3.0, 0.0, 0.0)));
+        assert!(close(m.inv.transform_point3(DVec3::new(3.0, 0.0, 0.0)), DVec3::X));
     }
 
     #[test]

@@ -28,9 +28,7 @@ pub struct BuildOptions {
 
 impl Default for BuildOptions {
     fn default() -> Self {
-        BuildOptions {
-            accel: AccelKind::Bvh,
-        }
+        BuildOptions { accel: AccelKind::Bvh }
     }
 }
 
@@ -70,9 +68,7 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         let t = &desc.transforms[s.transform as usize];
         let shape = match s.kind {
             ShapeKind::Sphere { center, radius } => {
-                let m = t.m
-                    * DAffine3::from_translation(center)
-                    * DAffine3::from_scale(DVec3::splat(radius));
+                let m = t.m * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
                 Shape::Sphere(Sphere::new(Transform::to_f32(&m)))
             }
             ShapeKind::Triangle { v } => {
@@ -175,10 +171,7 @@ fn check_settings(desc: &SceneDesc, diags: &mut Diagnostics) {
         }
     }
     let only_for = |name: &str, loc, diags: &mut Diagnostics| {
-        diags.warning(
-            loc,
-            format!("{name}: has no effect with integrator raytracer"),
-        );
+        diags.warning(loc, format!("{name}: has no effect with integrator raytracer"));
     };
     if let Some(v) = &desc.next_event_estimation {
         only_for("nexteventestimation", v.loc, diags);

@@ -232,10 +232,7 @@ impl Parser {
         let text = match std::str::from_utf8(raw) {
             Ok(t) => t,
             Err(e) => {
-                let col = String::from_utf8_lossy(&raw[..e.valid_up_to()])
-                    .chars()
-                    .count() as u32
-                    + 1;
+                let col = String::from_utf8_lossy(&raw[..e.valid_up_to()]).chars().count() as u32 + 1;
                 let byte = raw[e.valid_up_to()];
                 self.diags.error(
                     Loc {
@@ -249,11 +246,7 @@ impl Parser {
                 return;
             }
         };
-        if let Some((i, c)) = text
-            .chars()
-            .enumerate()
-            .find(|(_, c)| c.is_control() && *c != '\t')
-        {
+        if let Some((i, c)) = text.chars().enumerate().find(|(_, c)| c.is_control() && *c != '\t') {
             self.diags.error(
                 Loc {
                     file: self.file,
@@ -261,10 +254,7 @@ impl Parser {
                     col: i as u32 + 1,
                     len: 1,
                 },
-                format!(
-                    "unexpected control character U+{:04X}: scene files are text",
-                    c as u32
-                ),
+                format!("unexpected control character U+{:04X}: scene files are text", c as u32),
             );
             return;
         }
@@ -316,11 +306,7 @@ impl Parser {
             "maxdepth" => {
                 if let Some([d]) = self.ints::<1>(c) {
                     if d < -1 {
-                        self.err_arg(
-                            c,
-                            0,
-                            format!("maxdepth: depth must be -1 (unbounded) or more, got {d}"),
-                        );
+                        self.err_arg(c, 0, format!("maxdepth: depth must be -1 (unbounded) or more, got {d}"));
                     } else {
                         let v = Located {
                             value: d as i32,
@@ -344,11 +330,7 @@ impl Parser {
             "maxverts" | "maxvertnorms" => {
                 if let Some([n]) = self.ints::<1>(c) {
                     if n < 0 {
-                        self.err_arg(
-                            c,
-                            0,
-                            format!("{}: count must not be negative, got {n}", c.name.text),
-                        );
+                        self.err_arg(c, 0, format!("{}: count must not be negative, got {n}", c.name.text));
                     } else if c.name.text == "maxverts" {
                         self.max_verts = Some((n as u64, c.line));
                     } else {
@@ -375,9 +357,7 @@ impl Parser {
                         self.err_arg(c, 3, "vertexnormal: the normal has zero length");
                         return;
                     }
-                    self.desc
-                        .vertex_normals
-                        .push((DVec3::new(v[0], v[1], v[2]), n));
+                    self.desc.vertex_normals.push((DVec3::new(v[0], v[1], v[2]), n));
                     if let Some((max, line)) = self.max_vert_norms {
                         if self.desc.vertex_normals.len() as u64 > max && !self.warned_vert_norms {
                             self.warned_vert_norms = true;
@@ -459,12 +439,7 @@ impl Parser {
                     if let Some(k) = a.iter().position(|&x| x < 0.0) {
                         self.err_arg(c, k, "attenuation: coefficients must not be negative");
                     } else if a.iter().all(|&x| x == 0.0) {
-                        self.err_span(
-                            c,
-                            0,
-                            3,
-                            "attenuation: all three coefficients are zero (infinite light)",
-                        );
+                        self.err_span(c, 0, 3, "attenuation: all three coefficients are zero (infinite light)");
                     } else {
                         self.attenuation = DVec3::from_array(a);
                     }
@@ -486,11 +461,7 @@ impl Parser {
             "shininess" => {
                 if let Some([s]) = self.nums::<1>(c) {
                     if s < 0.0 {
-                        self.err_arg(
-                            c,
-                            0,
-                            format!("shininess: must not be negative, got {}", c.args[0].text),
-                        );
+                        self.err_arg(c, 0, format!("shininess: must not be negative, got {}", c.args[0].text));
                     } else {
                         self.material.base.shininess = s as f32;
                         self.material_id = None;
@@ -512,7 +483,12 @@ impl Parser {
                     let ab = DVec3::new(v[3], v[4], v[5]);
                     let ac = DVec3::new(v[6], v[7], v[8]);
                     if ab.cross(ac).length() == 0.0 {
-                        self.err_span(c, 3, 6, "quadLight: the edges ab and ac are parallel or zero (the light has no area)");
+                        self.err_span(
+                            c,
+                            3,
+                            6,
+                            "quadLight: the edges ab and ac are parallel or zero (the light has no area)",
+                        );
                         return;
                     }
                     let color = self.color_at(c, 9, &v[9..12]);
@@ -522,11 +498,7 @@ impl Parser {
             "lightsamples" | "spp" => {
                 if let Some([n]) = self.ints::<1>(c) {
                     if n < 1 {
-                        self.err_arg(
-                            c,
-                            0,
-                            format!("{}: must be at least 1, got {n}", c.name.text),
-                        );
+                        self.err_arg(c, 0, format!("{}: must be at least 1, got {n}", c.name.text));
                     } else if n > u32::MAX as i64 {
                         self.err_arg(c, 0, format!("{}: {n} is too large", c.name.text));
                     } else {
@@ -556,14 +528,7 @@ impl Parser {
                 }
             }
             "nexteventestimation" => {
-                if let Some(m) = self.keyword(
-                    c,
-                    &[
-                        ("on", NeeMode::On),
-                        ("off", NeeMode::Off),
-                        ("mis", NeeMode::Mis),
-                    ],
-                ) {
+                if let Some(m) = self.keyword(c, &[("on", NeeMode::On), ("off", NeeMode::Off), ("mis", NeeMode::Mis)]) {
                     let v = Located {
                         value: m,
                         loc: self.loc(c.line, &c.args[0]),
@@ -594,11 +559,7 @@ impl Parser {
             "roughness" => {
                 if let Some([a]) = self.nums::<1>(c) {
                     if a <= 0.0 {
-                        self.err_arg(
-                            c,
-                            0,
-                            format!("roughness: must be positive, got {}", c.args[0].text),
-                        );
+                        self.err_arg(c, 0, format!("roughness: must be positive, got {}", c.args[0].text));
                     } else {
                         self.material.roughness = a;
                         self.material_id = None;
@@ -608,11 +569,7 @@ impl Parser {
             "gamma" => {
                 if let Some([g]) = self.nums::<1>(c) {
                     if g <= 0.0 {
-                        self.err_arg(
-                            c,
-                            0,
-                            format!("gamma: must be positive, got {}", c.args[0].text),
-                        );
+                        self.err_arg(c, 0, format!("gamma: must be positive, got {}", c.args[0].text));
                     } else {
                         let v = Located {
                             value: g,
@@ -623,15 +580,16 @@ impl Parser {
                 }
             }
             name if NOT_YET_IMPLEMENTED.contains(&name) => {
-                self.err_cmd(c, format!("{name}: this lucent extension (docs/scene-format.md) is not implemented yet"));
+                self.err_cmd(
+                    c,
+                    format!("{name}: this lucent extension (docs/scene-format.md) is not implemented yet"),
+                );
             }
             name => {
-                let hint =
-                    suggestion(name).map_or(String::new(), |s| format!("; did you mean '{s}'?"));
+                let hint = suggestion(name).map_or(String::new(), |s| format!("; did you mean '{s}'?"));
                 let loc = self.loc(c.line, &c.name);
                 if self.options.strict {
-                    self.diags
-                        .error(loc, format!("unknown command '{name}'{hint}"));
+                    self.diags.error(loc, format!("unknown command '{name}'{hint}"));
                 } else {
                     self.diags
                         .warning(loc, format!("unknown command '{name}' ignored{hint}"));
@@ -648,11 +606,7 @@ impl Parser {
         };
         for (k, v) in [w, h].into_iter().enumerate() {
             if v < 1 {
-                self.err_arg(
-                    c,
-                    k,
-                    format!("size: width and height must be at least 1, got {v}"),
-                );
+                self.err_arg(c, k, format!("size: width and height must be at least 1, got {v}"));
                 return;
             }
         }
@@ -700,29 +654,19 @@ impl Parser {
                     c.args[9].text
                 ),
             ),
-            Err(CameraError::EyeAtTarget) => self.err_span(
-                c,
-                0,
-                6,
-                "camera: the eye and the look-at point are the same",
-            ),
-            Err(CameraError::UpParallelToView) => self.err_span(
-                c,
-                6,
-                3,
-                "camera: the up vector is parallel to the viewing direction",
-            ),
+            Err(CameraError::EyeAtTarget) => {
+                self.err_span(c, 0, 6, "camera: the eye and the look-at point are the same")
+            }
+            Err(CameraError::UpParallelToView) => {
+                self.err_span(c, 6, 3, "camera: the up vector is parallel to the viewing direction")
+            }
         }
     }
 
     fn sphere(&mut self, c: &Command) {
         let Some(v) = self.nums::<4>(c) else { return };
         if v[3] <= 0.0 {
-            self.err_arg(
-                c,
-                3,
-                format!("sphere: radius must be positive, got {}", c.args[3].text),
-            );
+            self.err_arg(c, 3, format!("sphere: radius must be positive, got {}", c.args[3].text));
             return;
         }
         let object = Transform::translate(DVec3::new(v[0], v[1], v[2]))
@@ -746,14 +690,18 @@ impl Parser {
         } else {
             self.desc.vertices.len()
         };
-        let what = if normals { "vertexnormal" } else { "vertex" };
+        let (one, many) = if normals {
+            ("vertexnormal", "vertexnormals")
+        } else {
+            ("vertex", "vertices")
+        };
         let mut v = [0u32; 3];
         for (k, &i) in idx.iter().enumerate() {
             if i < 0 || i as u64 >= pile as u64 {
-                let defined = if pile == 0 {
-                    format!("no {what} defined yet")
-                } else {
-                    format!("{pile} {what}s defined, valid 0..{}", pile - 1)
+                let defined = match pile {
+                    0 => format!("no {one} defined yet"),
+                    1 => format!("1 {one} defined, valid 0..0"),
+                    _ => format!("{pile} {many} defined, valid 0..{}", pile - 1),
                 };
                 self.err_arg(
                     c,
@@ -807,11 +755,7 @@ impl Parser {
         }
         let transform = self.transform_id();
         let loc = self.loc(c.line, &c.name);
-        self.desc.lights.push(LightDesc {
-            kind,
-            transform,
-            loc,
-        });
+        self.desc.lights.push(LightDesc { kind, transform, loc });
     }
 
     fn set_global<T>(
@@ -842,10 +786,8 @@ impl Parser {
         };
         self.desc.end = end;
         if self.desc.size.is_none() {
-            self.diags.error(
-                end,
-                "the scene has no 'size' command (required: size width height)",
-            );
+            self.diags
+                .error(end, "the scene has no 'size' command (required: size width height)");
         }
         if self.desc.camera.is_none() {
             self.diags.error(
@@ -938,19 +880,15 @@ impl Parser {
     fn number(&mut self, c: &Command, tok: &Token) -> Option<f64> {
         if !is_decimal(tok.text) {
             let loc = self.loc(c.line, tok);
-            self.diags.error(
-                loc,
-                format!("{}: '{}' is not a number", c.name.text, tok.text),
-            );
+            self.diags
+                .error(loc, format!("{}: '{}' is not a number", c.name.text, tok.text));
             return None;
         }
         let x: f64 = tok.text.parse().ok()?;
         if !x.is_finite() || x.abs() > f32::MAX as f64 {
             let loc = self.loc(c.line, tok);
-            self.diags.error(
-                loc,
-                format!("{}: {} is out of range", c.name.text, tok.text),
-            );
+            self.diags
+                .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
             return None;
         }
         Some(x)
@@ -975,18 +913,15 @@ impl Parser {
                 } else {
                     "is not a number"
                 };
-                self.diags
-                    .error(loc, format!("{}: '{}' {msg}", c.name.text, tok.text));
+                self.diags.error(loc, format!("{}: '{}' {msg}", c.name.text, tok.text));
                 ok = false;
                 continue;
             }
             match tok.text.parse::<i64>() {
                 Ok(v) if v.unsigned_abs() <= u32::MAX as u64 * 4 => out[k] = v,
                 _ => {
-                    self.diags.error(
-                        loc,
-                        format!("{}: {} is out of range", c.name.text, tok.text),
-                    );
+                    self.diags
+                        .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
                     ok = false;
                 }
             }
@@ -1005,18 +940,12 @@ impl Parser {
             return None;
         }
         let tok = &c.args[0];
-        let found = options
-            .iter()
-            .find(|(n, _)| *n == tok.text)
-            .map(|(_, v)| *v);
+        let found = options.iter().find(|(n, _)| *n == tok.text).map(|(_, v)| *v);
         if found.is_none() {
             let loc = self.loc(c.line, tok);
             self.diags.error(
                 loc,
-                format!(
-                    "{}: unknown value '{}' (expected {list})",
-                    c.name.text, tok.text
-                ),
+                format!("{}: unknown value '{}' (expected {list})", c.name.text, tok.text),
             );
         }
         found
@@ -1029,11 +958,7 @@ impl Parser {
             let loc = self.loc(c.line, &c.args[first + k]);
             self.diags.warning(
                 loc,
-                format!(
-                    "{}: negative colour component {}",
-                    c.name.text,
-                    c.args[first + k].text
-                ),
+                format!("{}: negative colour component {}", c.name.text, c.args[first + k].text),
             );
         }
         DVec3::new(v[0], v[1], v[2])
@@ -1095,9 +1020,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
     for (i, ca) in a.chars().enumerate() {
         let mut cur = vec![i + 1; b.len() + 1];
         for (j, &cb) in b.iter().enumerate() {
-            cur[j + 1] = (prev[j] + (ca != cb) as usize)
-                .min(prev[j + 1] + 1)
-                .min(cur[j] + 1);
+            cur[j + 1] = (prev[j] + (ca != cb) as usize).min(prev[j + 1] + 1).min(cur[j] + 1);
         }
         prev = cur;
     }

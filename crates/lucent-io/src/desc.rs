@@ -40,10 +40,7 @@ impl IntegratorKind {
     ];
 
     pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, k)| *k == self)
-            .map_or("?", |(n, _)| n)
+        Self::ALL.iter().find(|(_, k)| *k == self).map_or("?", |(n, _)| n)
     }
 }
 
@@ -167,9 +164,7 @@ impl SceneDesc {
     }
 
     pub fn integrator(&self) -> IntegratorKind {
-        self.integrator
-            .as_ref()
-            .map_or(IntegratorKind::RayTracer, |i| i.value)
+        self.integrator.as_ref().map_or(IntegratorKind::RayTracer, |i| i.value)
     }
 
     pub fn gamma(&self) -> f64 {

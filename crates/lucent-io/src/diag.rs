@@ -34,16 +34,12 @@ impl SourceMap {
     }
 
     pub fn name(&self, file: u32) -> &str {
-        self.files
-            .get(file as usize)
-            .map_or("<unknown>", |f| &f.name)
+        self.files.get(file as usize).map_or("<unknown>", |f| &f.name)
     }
 
     pub fn line(&self, loc: Loc) -> Option<&str> {
         let f = self.files.get(loc.file as usize)?;
-        f.lines
-            .get((loc.line as usize).checked_sub(1)?)
-            .map(|s| s.as_str())
+        f.lines.get((loc.line as usize).checked_sub(1)?).map(|s| s.as_str())
     }
 
     pub fn line_count(&self, file: u32) -> usize {
@@ -137,11 +133,7 @@ impl Diagnostics {
             out.push_str(&render_one(d, sources));
         }
         if self.suppressed_errors > 0 {
-            let _ = writeln!(
-                out,
-                "error: {} more errors not shown",
-                self.suppressed_errors
-            );
+            let _ = writeln!(out, "error: {} more errors not shown", self.suppressed_errors);
         }
         out
     }
@@ -168,13 +160,7 @@ pub fn render_one(d: &Diagnostic, sources: &SourceMap) -> String {
             .collect();
         let shown: String = text
             .chars()
-            .map(|c| {
-                if c.is_control() && c != '\t' {
-                    '\u{fffd}'
-                } else {
-                    c
-                }
-            })
+            .map(|c| if c.is_control() && c != '\t' { '\u{fffd}' } else { c })
             .collect();
         let _ = writeln!(
             out,
@@ -192,10 +178,7 @@ mod tests {
     #[test]
     fn renders_location_line_and_caret() {
         let mut sources = SourceMap::default();
-        let f = sources.add(
-            "a.test".into(),
-            vec!["size 10 10".into(), "sphere 0 0 0 -1".into()],
-        );
+        let f = sources.add("a.test".into(), vec!["size 10 10".into(), "sphere 0 0 0 -1".into()]);
         let mut d = Diagnostics::default();
         d.error(
             Loc {

@@ -59,9 +59,7 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(),
         image::codecs::png::PngEncoder::new(&mut out)
             .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
             .map_err(|e| write_error(path, e))?;
-        let file = out
-            .into_inner()
-            .map_err(|e| io_write_error(path, e.error()))?;
+        let file = out.into_inner().map_err(|e| io_write_error(path, e.error()))?;
         file.sync_all().map_err(|e| io_write_error(path, &e))?;
         fs::rename(&tmp, path).map_err(|e| io_write_error(path, &e))
     })();

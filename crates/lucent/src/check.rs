@@ -22,23 +22,12 @@ pub struct CheckArgs {
 }
 
 pub fn run(args: &CheckArgs) -> u8 {
-    let (desc, mut diags) = parse_file(
-        &args.scene,
-        ParseOptions {
-            strict: args.strict,
-        },
-    );
+    let (desc, mut diags) = parse_file(&args.scene, ParseOptions { strict: args.strict });
     // The list needs no build time and reports the same problems as the BVH.
     let built = if diags.has_errors() {
         None
     } else {
-        build(
-            &desc,
-            &BuildOptions {
-                accel: AccelKind::List,
-            },
-            &mut diags,
-        )
+        build(&desc, &BuildOptions { accel: AccelKind::List }, &mut diags)
     };
     report(&diags, &desc.sources);
     let Some(built) = built else {

@@ -8,11 +8,7 @@ use lucent_io::diag::{Diagnostics, Loc, SourceMap};
 /// The output file: `-o`, else the scene's `output` command (relative to the current
 /// directory, SCENE_FORMAT.md §3.1), else `raytrace.png`. Only PNG is written by this
 /// version; a name with another extension gets PNG and a warning, `.exr` is refused.
-pub fn choose_output(
-    cli: Option<&Path>,
-    desc: &SceneDesc,
-    diags: &mut Diagnostics,
-) -> Result<PathBuf, String> {
+pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnostics) -> Result<PathBuf, String> {
     let (path, loc): (PathBuf, Option<Loc>) = match (cli, &desc.output) {
         (Some(p), _) => (p.to_path_buf(), None),
         (None, Some(o)) => (PathBuf::from(&o.value), Some(o.loc)),
@@ -26,10 +22,7 @@ pub fn choose_output(
             path.display()
         )),
         _ => {
-            let msg = format!(
-                "output: '{}' does not end in .png; writing PNG anyway",
-                path.display()
-            );
+            let msg = format!("output: '{}' does not end in .png; writing PNG anyway", path.display());
             match loc {
                 Some(loc) => diags.warning(loc, msg),
                 None => eprintln!("lucent: warning: {msg}"),

@@ -14,13 +14,10 @@ impl Progress {
         let bar = if quiet || !std::io::stderr().is_terminal() {
             ProgressBar::hidden()
         } else {
-            let bar =
-                ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr_with_hz(10));
-            let style = ProgressStyle::with_template(
-                "{elapsed_precise} [{wide_bar}] {percent:>3}%  ETA {eta_precise}",
-            )
-            .expect("valid template")
-            .progress_chars("=> ");
+            let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr_with_hz(10));
+            let style = ProgressStyle::with_template("{elapsed_precise} [{wide_bar}] {percent:>3}%  ETA {eta_precise}")
+                .expect("valid template")
+                .progress_chars("=> ");
             bar.set_style(style);
             bar
         };

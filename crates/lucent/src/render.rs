@@ -43,12 +43,7 @@ pub struct RenderArgs {
 pub fn run(args: &RenderArgs) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t_start = Instant::now();
-    let (desc, mut diags) = parse_file(
-        &args.scene,
-        ParseOptions {
-            strict: args.strict,
-        },
-    );
+    let (desc, mut diags) = parse_file(&args.scene, ParseOptions { strict: args.strict });
     let t_parsed = Instant::now();
     if diags.has_errors() {
         report(&diags, &desc.sources);

@@ -98,17 +98,9 @@ impl Builder<'_> {
         let (bounds, centroid_bounds) = self.range_bounds(start, end);
         let me = self.nodes.len();
         self.nodes.push(Node {
-            min: if bounds.is_empty() {
-                [0.0; 3]
-            } else {
-                bounds.min.into()
-            },
+            min: if bounds.is_empty() { [0.0; 3] } else { bounds.min.into() },
             first_or_right: start as u32,
-            max: if bounds.is_empty() {
-                [0.0; 3]
-            } else {
-                bounds.max.into()
-            },
+            max: if bounds.is_empty() { [0.0; 3] } else { bounds.max.into() },
             count: (end - start) as u32,
         });
         let count = end - start;
@@ -177,12 +169,7 @@ impl Builder<'_> {
         }
         let (cost, axis, split) = best?;
         let area = bounds.surface_area();
-        let split_cost = TRAVERSAL_COST
-            + if area > 0.0 {
-                cost / area
-            } else {
-                count as f32
-            };
+        let split_cost = TRAVERSAL_COST + if area > 0.0 { cost / area } else { count as f32 };
         if count <= MAX_LEAF && split_cost >= count as f32 {
             return None;
         }
@@ -243,28 +230,16 @@ impl Accelerator for Bvh {
                 for &pi in &self.indices[first..first + n.count as usize] {
                     if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
                         if Hit::is_closer_than(t, pi, &best) {
-                            best = Some(Hit {
-                                t,
-                                prim: pi,
-                                b1,
-                                b2,
-                            });
+                            best = Some(Hit { t, prim: pi, b1, b2 });
                             t_max = t;
                         }
                     }
                 }
             } else {
                 let (left, right) = (node + 1, n.first_or_right as usize);
-                match (
-                    self.nodes[left].hit(&r, t_max),
-                    self.nodes[right].hit(&r, t_max),
-                ) {
+                match (self.nodes[left].hit(&r, t_max), self.nodes[right].hit(&r, t_max)) {
                     (Some(tl), Some(tr)) => {
-                        let (near, far) = if tl <= tr {
-                            (left, right)
-                        } else {
-                            (right, left)
-                        };
+                        let (near, far) = if tl <= tr { (left, right) } else { (right, left) };
                         stack[sp] = far as u32;
                         sp += 1;
                         node = near;
@@ -402,14 +377,9 @@ mod tests {
                 Ray::segment(Vec3A::new(x, y, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY)
             })
             .collect();
-        rays.extend((0..200).map(|i| {
-            Ray::segment(
-                Vec3A::new(-1.0, i as f32 * 0.1, 0.0),
-                Vec3A::X,
-                1e-4,
-                f32::INFINITY,
-            )
-        }));
+        rays.extend(
+            (0..200).map(|i| Ray::segment(Vec3A::new(-1.0, i as f32 * 0.1, 0.0), Vec3A::X, 1e-4, f32::INFINITY)),
+        );
         assert!(check_against_list(&prims, rays.into_iter()) >= 2000);
     }
 

@@ -4,14 +4,7 @@
 use crate::math::Vec3A;
 
 /// `None` when the ray is parallel to the plane or the hit is outside `(t_min, t_max]`.
-pub fn intersect_plane(
-    o: Vec3A,
-    d: Vec3A,
-    point: Vec3A,
-    normal: Vec3A,
-    t_min: f32,
-    t_max: f32,
-) -> Option<f32> {
+pub fn intersect_plane(o: Vec3A, d: Vec3A, point: Vec3A, normal: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
     let denom = d.dot(normal);
     if denom == 0.0 {
         return None;
@@ -70,14 +63,6 @@ mod tests {
         )
         .is_none());
         // Starting on the plane: the re-intersection at t = 0 is rejected.
-        assert!(intersect_plane(
-            Vec3A::ZERO,
-            Vec3A::Y,
-            Vec3A::ZERO,
-            Vec3A::Y,
-            1e-4,
-            f32::INFINITY
-        )
-        .is_none());
+        assert!(intersect_plane(Vec3A::ZERO, Vec3A::Y, Vec3A::ZERO, Vec3A::Y, 1e-4, f32::INFINITY).is_none());
     }
 }

@@ -64,8 +64,7 @@ fn nearest_root(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<f32> {
 mod tests {
     use super::*;
 
-    const BOTH: [fn(Vec3A, Vec3A, f32, f32) -> Option<f32>; 2] =
-        [intersect_unit_algebraic, intersect_unit_geometric];
+    const BOTH: [fn(Vec3A, Vec3A, f32, f32) -> Option<f32>; 2] = [intersect_unit_algebraic, intersect_unit_geometric];
 
     #[test]
     fn head_on_hit_is_at_distance_minus_radius() {
@@ -151,10 +150,7 @@ mod tests {
                 _ => {
                     let tc = -o.dot(d) / d.dot(d);
                     let r = (o + d * tc).length();
-                    assert!(
-                        (r - 1.0).abs() < 1e-3,
-                        "disagreement away from the rim: r = {r}"
-                    );
+                    assert!((r - 1.0).abs() < 1e-3, "disagreement away from the rim: r = {r}");
                 }
             }
         }

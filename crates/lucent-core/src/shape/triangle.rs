@@ -23,13 +23,7 @@ pub struct TriangleHit {
 /// Watertight ray–triangle test. Both sides of the triangle are hit. `t` must lie in
 /// `(t_min, t_max]`.
 #[inline(always)]
-pub fn intersect(
-    r: &PreparedRay,
-    p0: Vec3A,
-    p1: Vec3A,
-    p2: Vec3A,
-    t_max: f32,
-) -> Option<TriangleHit> {
+pub fn intersect(r: &PreparedRay, p0: Vec3A, p1: Vec3A, p2: Vec3A, t_max: f32) -> Option<TriangleHit> {
     let o = r.ray.origin;
     let a = p0 - o;
     let b = p1 - o;
@@ -143,9 +137,7 @@ mod tests {
             f32::INFINITY,
         )
         .unwrap();
-        assert!(
-            (c.t - h.t).abs() < 1e-6 && (c.b1 - h.b1).abs() < 1e-6 && (c.b2 - h.b2).abs() < 1e-6
-        );
+        assert!((c.t - h.t).abs() < 1e-6 && (c.b1 - h.b1).abs() < 1e-6 && (c.b2 - h.b2).abs() < 1e-6);
     }
 
     #[test]
@@ -159,8 +151,7 @@ mod tests {
         ] {
             assert!(hit(p, -Vec3A::Z, TRI).is_some(), "{p}");
             assert!(
-                intersect_cramer(p, -Vec3A::Z, TRI[0], TRI[1], TRI[2], 1e-4, f32::INFINITY)
-                    .is_some(),
+                intersect_cramer(p, -Vec3A::Z, TRI[0], TRI[1], TRI[2], 1e-4, f32::INFINITY).is_some(),
                 "{p}"
             );
         }
@@ -177,12 +168,7 @@ mod tests {
 
     #[test]
     fn a_ray_leaving_the_surface_does_not_hit_it_again() {
-        assert!(hit(
-            Vec3A::new(0.2, 0.2, 0.0),
-            Vec3A::new(0.3, 0.1, 1.0).normalize(),
-            TRI
-        )
-        .is_none());
+        assert!(hit(Vec3A::new(0.2, 0.2, 0.0), Vec3A::new(0.3, 0.1, 1.0).normalize(), TRI).is_none());
     }
 
     #[test]

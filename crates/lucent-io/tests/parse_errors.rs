@@ -1,0 +1,338 @@
+//! Every malformed-scene case gets an exact `file:line:col` message. Each case is a
+//! scene with a valid header plus one bad line (line 3).
+
+use lucent_io::build::{build, BuildOptions};
+use lucent_io::cse167::{parse_bytes, ParseOptions};
+use lucent_io::diag::Severity;
+
+const HEADER: &str = "size 64 48\ncamera 0 0 5 0 0 0 0 1 0 45\n";
+
+/// The first line of every error and warning (parse and build), in order.
+fn messages(text: &str, strict: bool) -> Vec<String> {
+    let (desc, mut diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions { strict });
+    if !diags.has_errors() {
+        build(&desc, &BuildOptions::default(), &mut diags);
+    }
+    diags
+        .items
+        .iter()
+        .filter(|d| d.severity != Severity::Note)
+        .map(|d| diags_line(&d.severity.to_string(), d.loc.line, d.loc.col, &d.message))
+        .collect()
+}
+
+fn diags_line(sev: &str, line: u32, col: u32, msg: &str) -> String {
+    format!("t.test:{line}:{col}: {sev}: {msg}")
+}
+
+fn first_error(bad_line: &str) -> String {
+    let all = messages(&format!("{HEADER}{bad_line}\n"), false);
+    all.into_iter()
+        .find(|m| m.contains(": error: "))
+        .unwrap_or_else(|| panic!("no error for {bad_line:?}"))
+}
+
+#[test]
+fn argument_counts() {
+    assert_eq!(
+        first_error("camera 0 0 5 0 0 0 0 1 0"),
+        "t.test:3:25: error: camera: expected 10 numbers, got 9 arguments"
+    );
+    assert_eq!(
+        first_error("sphere 0 0 0 1 2"),
+        "t.test:3:16: error: sphere: expected 4 numbers, got 5 arguments"
+    );
+    assert_eq!(
+        first_error("pushTransform 1"),
+        "t.test:3:15: error: pushTransform: expected no arguments, got 1 argument"
+    );
+    assert_eq!(
+        first_error("output"),
+        "t.test:3:7: error: output: expected a file name, got 0 arguments"
+    );
+}
+
+#[test]
+fn malformed_and_non_finite_numbers() {
+    assert_eq!(
+        first_error("translate 1 x 2"),
+        "t.test:3:13: error: translate: 'x' is not a number"
+    );
+    assert_eq!(
+        first_error("translate 1 inf 2"),
+        "t.test:3:13: error: translate: 'inf' is not a number"
+    );
+    assert_eq!(
+        first_error("translate nan 0 2"),
+        "t.test:3:11: error: translate: 'nan' is not a number"
+    );
+    assert_eq!(
+        first_error("translate 0x10 0 2"),
+        "t.test:3:11: error: translate: '0x10' is not a number"
+    );
+    assert_eq!(
+        first_error("translate 1e39 0 2"),
+        "t.test:3:11: error: translate: 1e39 is out of range"
+    );
+    assert_eq!(
+        first_error("maxdepth 2.5"),
+        "t.test:3:10: error: maxdepth: '2.5' is not an integer"
+    );
+    assert_eq!(
+        first_error("tri 0 1 two"),
+        "t.test:3:9: error: tri: 'two' is not a number"
+    );
+}
+
+#[test]
+fn impossible_values() {
+    assert_eq!(
+        first_error("sphere 0 0 0 -1"),
+        "t.test:3:14: error: sphere: radius must be positive, got -1"
+    );
+    assert_eq!(
+        first_error("sphere 0 0 0 0"),
+        "t.test:3:14: error: sphere: radius must be positive, got 0"
+    );
+    assert_eq!(
+        first_error("rotate 0 0 0 30"),
+        "t.test:3:8: error: rotate: the rotation axis is zero"
+    );
+    assert_eq!(
+        first_error("scale 1 0 1"),
+        "t.test:3:9: error: scale: a zero factor makes the transform singular"
+    );
+    assert_eq!(
+        first_error("directional 0 0 0 1 1 1"),
+        "t.test:3:13: error: directional: the direction is zero"
+    );
+    assert_eq!(
+        first_error("attenuation 0 0 0"),
+        "t.test:3:13: error: attenuation: all three coefficients are zero (infinite light)"
+    );
+    assert_eq!(
+        first_error("attenuation 1 -1 0"),
+        "t.test:3:15: error: attenuation: coefficients must not be negative"
+    );
+    assert_eq!(
+        first_error("maxdepth -2"),
+        "t.test:3:10: error: maxdepth: depth must be -1 (unbounded) or more, got -2"
+    );
+    assert_eq!(
+        first_error("shininess -3"),
+        "t.test:3:11: error: shininess: must not be negative, got -3"
+    );
+    assert_eq!(
+        first_error("spp 0"),
+        "t.test:3:5: error: spp: must be at least 1, got 0"
+    );
+    assert_eq!(
+        first_error("lightsamples -4"),
+        "t.test:3:14: error: lightsamples: must be at least 1, got -4"
+    );
+    assert_eq!(
+        first_error("gamma 0"),
+        "t.test:3:7: error: gamma: must be positive, got 0"
+    );
+    assert_eq!(
+        first_error("roughness 0"),
+        "t.test:3:11: error: roughness: must be positive, got 0"
+    );
+    assert_eq!(
+        first_error("quadLight 0 0 0 1 0 0 2 0 0 1 1 1"),
+        "t.test:3:17: error: quadLight: the edges ab and ac are parallel or zero (the light has no area)"
+    );
+    assert_eq!(
+        first_error("vertexnormal 0 0 0 0 0 0"),
+        "t.test:3:20: error: vertexnormal: the normal has zero length"
+    );
+}
+
+#[test]
+fn indices_out_of_range() {
+    assert_eq!(
+        first_error("tri 0 1 2"),
+        "t.test:3:5: error: tri: vertex index 0 out of range (no vertex defined yet)"
+    );
+    let text = format!("{HEADER}vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\ntri 0 1 3\n");
+    assert_eq!(
+        messages(&text, false)[0],
+        "t.test:6:9: error: tri: vertex index 3 out of range (3 vertices defined, valid 0..2)"
+    );
+    let text = format!("{HEADER}vertex 0 0 0\ntri -1 0 0\n");
+    assert_eq!(
+        messages(&text, false)[0],
+        "t.test:4:5: error: tri: vertex index -1 out of range (1 vertex defined, valid 0..0)"
+    );
+    assert_eq!(
+        first_error("trinormal 0 0 0"),
+        "t.test:3:11: error: trinormal: vertex index 0 out of range (no vertexnormal defined yet)"
+    );
+}
+
+#[test]
+fn transform_stack() {
+    assert_eq!(
+        first_error("popTransform"),
+        "t.test:3:1: error: popTransform: transform stack is empty"
+    );
+    let ok = format!("{HEADER}pushTransform\npushTransform\npopTransform\n");
+    assert!(messages(&ok, false).is_empty());
+}
+
+#[test]
+fn camera_and_size() {
+    assert_eq!(
+        first_error("camera 0 0 5 0 0 0 0 1 0 180"),
+        "t.test:3:26: error: camera: field of view must be between 0 and 180 degrees, got 180"
+    );
+    assert_eq!(
+        first_error("camera 1 2 3 1 2 3 0 1 0 45"),
+        "t.test:3:8: error: camera: the eye and the look-at point are the same"
+    );
+    assert_eq!(
+        first_error("camera 0 5 0 0 0 0 0 2 0 45"),
+        "t.test:3:20: error: camera: the up vector is parallel to the viewing direction"
+    );
+    assert_eq!(
+        first_error("size 0 10"),
+        "t.test:3:6: error: size: width and height must be at least 1, got 0"
+    );
+    assert_eq!(
+        first_error("size 100000 100000"),
+        "t.test:3:6: error: size: 100000 x 100000 is too large (at most 67108864 pixels)"
+    );
+    assert_eq!(
+        messages("camera 0 0 5 0 0 0 0 1 0 45\n", false),
+        ["t.test:1:1: error: the scene has no 'size' command (required: size width height)"]
+    );
+    assert_eq!(
+        messages("size 10 10\n", false),
+        ["t.test:1:1: error: the scene has no 'camera' command (required: camera from at up fovy)"]
+    );
+    assert_eq!(messages("", false).len(), 2);
+}
+
+#[test]
+fn keywords() {
+    assert_eq!(first_error("integrator magic"), "t.test:3:12: error: integrator: unknown value 'magic' (expected raytracer, analyticdirect, direct or pathtracer)");
+    assert_eq!(
+        first_error("lightstratify yes"),
+        "t.test:3:15: error: lightstratify: unknown value 'yes' (expected on or off)"
+    );
+    assert_eq!(
+        first_error("brdf lambert"),
+        "t.test:3:6: error: brdf: unknown value 'lambert' (expected phong or ggx)"
+    );
+    let text = format!("{HEADER}lightsamples 8\nlightstratify on\n");
+    assert_eq!(
+        messages(&text, false),
+        ["t.test:3:14: error: lightsamples: 'lightstratify on' needs a perfect square, got 8"]
+    );
+}
+
+#[test]
+fn binary_garbage_and_encoding() {
+    let mut bytes = HEADER.as_bytes().to_vec();
+    bytes.extend_from_slice(b"sphere 0 0 \xff\xfe 1\n");
+    let (_, diags) = parse_bytes("t.test", &bytes, ParseOptions::default());
+    assert_eq!(
+        diags.items[0].message,
+        "invalid UTF-8 (byte 0xFF): scene files are text"
+    );
+    assert_eq!((diags.items[0].loc.line, diags.items[0].loc.col), (3, 12));
+    let (_, diags) = parse_bytes("t.test", b"size 1 1\x00\n", ParseOptions::default());
+    assert_eq!(
+        diags.items[0].message,
+        "unexpected control character U+0000: scene files are text"
+    );
+    assert_eq!(diags.items[0].loc.col, 9);
+    // A large binary blob stops after a bounded number of errors.
+    let blob: Vec<u8> = (0..200_000u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+        .collect();
+    let (_, diags) = parse_bytes("t.test", &blob, ParseOptions::default());
+    assert!(diags.has_errors() && diags.items.len() < 200);
+}
+
+#[test]
+fn unknown_commands_warn_or_fail_in_strict_mode() {
+    let text = format!("{HEADER}pushtransform\nfrobnicate 1\n");
+    assert_eq!(
+        messages(&text, false),
+        [
+            "t.test:3:1: warning: unknown command 'pushtransform' ignored; did you mean 'pushTransform'?",
+            "t.test:4:1: warning: unknown command 'frobnicate' ignored"
+        ]
+    );
+    assert_eq!(
+        messages(&text, true)[0],
+        "t.test:3:1: error: unknown command 'pushtransform'; did you mean 'pushTransform'?"
+    );
+}
+
+#[test]
+fn unsupported_features_are_errors_not_silent_differences() {
+    assert_eq!(
+        first_error("plane 0 0 0 0 1 0"),
+        "t.test:3:1: error: plane: this lucent extension (docs/scene-format.md) is not implemented yet"
+    );
+    assert_eq!(
+        first_error("integrator pathtracer"),
+        "t.test:3:12: error: integrator: 'pathtracer' is not implemented yet (this version renders 'raytracer')"
+    );
+    assert_eq!(
+        first_error("quadLight 0 0 0 1 0 0 0 1 0 1 1 1"),
+        "t.test:3:1: error: quadLight: area lights are not implemented yet in the raytracer integrator"
+    );
+    assert_eq!(
+        first_error("spp 4"),
+        "t.test:3:5: error: spp: antialiasing (more than 1 sample per pixel) is not implemented yet"
+    );
+}
+
+#[test]
+fn warnings() {
+    let text = "camera 0 0 5 0 0 0 0 1 0 45\nsize 8 8\nsize 9 9\nmaxverts 1\nvertex 0 0 0\nvertex 1 0 0\nvertex 2 0 0\ntri 0 1 2\ndiffuse -1 0 0\ntranslate 1 0 0\npoint 0 0 0 1 1 1\n";
+    assert_eq!(
+        messages(text, false),
+        [
+            "t.test:2:1: warning: size: should be the first command of the file",
+            "t.test:3:1: warning: size: given again (previously on line 2); the last one wins",
+            "t.test:6:1: warning: vertex: vertex #1 exceeds 'maxverts 1' (line 4); continuing (hint only)",
+            "t.test:9:9: warning: diffuse: negative colour component -1",
+            "t.test:11:1: warning: point: the light is transformed by the current transform (the course's renderers ignore transforms on lights)",
+            "t.test:8:1: warning: degenerate triangle (zero area) skipped",
+        ]
+    );
+}
+
+#[test]
+fn lexical_rules() {
+    // BOM, CRLF, tabs, trailing comments, comment lines, blank lines, +1 and .5.
+    let text = "\u{feff}# comment\r\nsize 8 8\r\n\r\n   \t\ncamera\t0 0 +5  0 0 0 0 1 0 45 # trailing\r\n  # indented comment\nsphere .5 -.25 0 +1\n";
+    assert!(messages(text, false).is_empty());
+    let (desc, _) = parse_bytes("t.test", text.as_bytes(), ParseOptions::default());
+    assert_eq!(desc.shapes.len(), 1);
+    assert_eq!(desc.camera.unwrap().value.eye.z, 5.0);
+}
+
+#[test]
+fn state_is_captured_per_object() {
+    let text = format!(
+        "{HEADER}vertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\ndiffuse 1 0 0\npushTransform\ntranslate 0 0 2\ntri 0 1 2\npopTransform\ndiffuse 0 1 0\ntri 0 1 2\nattenuation 1 2 3\npoint 0 0 0 1 1 1\nattenuation 1 0 0\n"
+    );
+    let (desc, diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions::default());
+    assert!(!diags.has_errors());
+    let [a, b] = [desc.shapes[0], desc.shapes[1]];
+    assert_eq!(desc.materials[a.material as usize].base.diffuse.x, 1.0);
+    assert_eq!(desc.materials[b.material as usize].base.diffuse.y, 1.0);
+    assert_eq!(desc.transforms[a.transform as usize].point(glam::DVec3::ZERO).z, 2.0);
+    assert!(desc.transforms[b.transform as usize].is_identity());
+    match desc.lights[0].kind {
+        lucent_io::desc::LightKind::Point { attenuation, .. } => {
+            assert_eq!(attenuation, glam::DVec3::new(1.0, 2.0, 3.0))
+        }
+        _ => panic!(),
+    }
+}

@@ -1,0 +1,93 @@
+//! The parser and build step never panic, whatever the input: random mutations of a
+//! valid scene (a deterministic fuzzer that runs with the tests; `fuzz/` has the
+//! coverage-guided one).
+
+use lucent_io::build::{build, BuildOptions};
+use lucent_io::cse167::{parse_bytes, ParseOptions};
+
+const SEED_SCENE: &str = "size 16 12\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 3\nattenuation 1 0.1 0.01\npoint 1 2 3 1 1 1\ndirectional 0 1 1 .5 .5 .5\nmaxverts 4\nvertex -1 -1 0\nvertex 1 -1 0\nvertex 1 1 0\nvertexnormal 0 0 0 0 0 1\nvertexnormal 1 0 0 0 1 1\nvertexnormal 0 1 0 1 0 1\ndiffuse 0.5 0.2 0.1\nspecular .3 .3 .3\nshininess 20\npushTransform\nrotate 0 1 0 30\nscale 1 2 0.5\nsphere 0 0 0 1\ntri 0 1 2\ntrinormal 0 1 2\npopTransform\nintegrator raytracer\ngamma 2.2\n";
+
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n as u64) as usize
+    }
+}
+
+const INTERESTING: &[&str] = &[
+    "0",
+    "-1",
+    "1e38",
+    "-1e38",
+    "1e-45",
+    "nan",
+    "inf",
+    "99999999999999999999",
+    "+",
+    ".",
+    "\u{0}",
+    "\u{ff}",
+    "#",
+    "\t",
+    "popTransform",
+    "pushTransform",
+    "tri",
+    "sphere",
+    "size",
+    "4294967296",
+    "-2147483649",
+    "\r",
+    "\n",
+];
+
+#[test]
+fn random_mutations_never_panic() {
+    let mut rng = Rng(0x5eed);
+    let tokens: Vec<&str> = SEED_SCENE.split([' ', '\n']).collect();
+    for _ in 0..3000 {
+        let mut bytes = SEED_SCENE.as_bytes().to_vec();
+        for _ in 0..1 + rng.below(6) {
+            let pos = rng.below(bytes.len() + 1);
+            match rng.below(5) {
+                0 if pos < bytes.len() => bytes[pos] = rng.next() as u8,
+                1 if pos < bytes.len() => {
+                    bytes.remove(pos);
+                }
+                2 => {
+                    let t = INTERESTING[rng.below(INTERESTING.len())];
+                    bytes.splice(pos..pos, t.bytes());
+                }
+                3 => {
+                    let t = tokens[rng.below(tokens.len())];
+                    bytes.splice(pos..pos, format!(" {t}").into_bytes());
+                }
+                _ => {
+                    let end = (pos + rng.below(40)).min(bytes.len());
+                    bytes.drain(pos..end);
+                }
+            }
+        }
+        let (desc, mut diags) = parse_bytes(
+            "fuzz.test",
+            &bytes,
+            ParseOptions {
+                strict: rng.below(2) == 0,
+            },
+        );
+        if !diags.has_errors() {
+            // Keep the render cheap: whatever size survived, shrink it.
+            if let Some(built) = build(&desc, &BuildOptions::default(), &mut diags) {
+                let scene = built.scene;
+                let ray = scene.camera.ray(0.5, 0.5);
+                let _ = scene.closest_hit(&ray);
+            }
+        }
+        let _ = diags.render(&desc.sources);
+    }
+}
