@@ -29,7 +29,7 @@ pub fn run(args: &CheckArgs) -> u8 {
     } else {
         build(&desc, &BuildOptions { accel: AccelKind::List }, &mut diags)
     };
-    report(&diags, &desc.sources);
+    report(&diags, &desc.sources, true);
     let Some(built) = built else {
         return EXIT_BAD_INPUT;
     };

@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use lucent_io::desc::SceneDesc;
-use lucent_io::diag::{Diagnostics, Loc, SourceMap};
+use lucent_io::diag::{Diagnostics, Loc, Severity, SourceMap};
 
 /// The output file: `-o`, else the scene's `output` command (relative to the current
 /// directory, SCENE_FORMAT.md §3.1), else `raytrace.png`. Only PNG is written by this
@@ -32,9 +32,14 @@ pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnosti
     }
 }
 
-/// Prints every diagnostic to stderr.
-pub fn report(diags: &Diagnostics, sources: &SourceMap) {
-    let text = diags.render(sources);
+/// Prints errors and warnings to stderr, and notes too when `notes` is set (`check`
+/// shows them; `render` keeps quiet about what is harmless).
+pub fn report(diags: &Diagnostics, sources: &SourceMap, notes: bool) {
+    let mut shown = diags.clone();
+    if !notes {
+        shown.items.retain(|d| d.severity != Severity::Note);
+    }
+    let text = shown.render(sources);
     if !text.is_empty() {
         eprint!("{text}");
     }

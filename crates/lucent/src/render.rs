@@ -46,20 +46,20 @@ pub fn run(args: &RenderArgs) -> u8 {
     let (desc, mut diags) = parse_file(&args.scene, ParseOptions { strict: args.strict });
     let t_parsed = Instant::now();
     if diags.has_errors() {
-        report(&diags, &desc.sources);
+        report(&diags, &desc.sources, false);
         return EXIT_BAD_INPUT;
     }
 
     let out = match choose_output(args.output.as_deref(), &desc, &mut diags) {
         Ok(out) => out,
         Err(msg) => {
-            report(&diags, &desc.sources);
+            report(&diags, &desc.sources, false);
             eprintln!("lucent: error: {msg}");
             return EXIT_BAD_INPUT;
         }
     };
     if let Err(e) = check_writable(&out) {
-        report(&diags, &desc.sources);
+        report(&diags, &desc.sources, false);
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
@@ -67,7 +67,7 @@ pub fn run(args: &RenderArgs) -> u8 {
     let t_build = Instant::now();
     let built = build(&desc, &BuildOptions { accel }, &mut diags);
     let t_built = Instant::now();
-    report(&diags, &desc.sources);
+    report(&diags, &desc.sources, false);
     let Some(built) = built else {
         return EXIT_BAD_INPUT;
     };

@@ -1,0 +1,210 @@
+//! The `lucent` binary end to end: exit codes, messages, and what is (not) written.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const SCENE: &str = "size 32 24\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 1 1 3 1 1 1\ndiffuse 0.6 0.3 0.2\nspecular 0.3 0.3 0.3\nsphere 0 0 0 1\nvertex -3 -1 -3\nvertex 3 -1 -3\nvertex 3 -1 3\ntri 0 2 1\n";
+
+/// A fresh, empty directory for one test.
+fn workdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lucent-cli-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn lucent(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run lucent")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn renders_a_png_named_by_the_option_the_scene_or_the_default() {
+    let dir = workdir("names");
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "-o", "x.png"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = fs::read(dir.join("x.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    // Summary line: resolution, primitives, rays, seconds, Mrays/s.
+    let err = stderr(&o);
+    assert!(
+        err.contains("32x24, 2 primitives, ") && err.contains(" rays, ") && err.contains(" Mrays/s"),
+        "{err}"
+    );
+
+    fs::write(dir.join("b.test"), format!("{SCENE}output named.png\n")).unwrap();
+    assert!(lucent(&dir, &["render", "b.test", "-q"]).status.success());
+    assert!(dir.join("named.png").exists());
+    assert!(lucent(&dir, &["render", "a.test", "--quiet"]).status.success());
+    assert!(dir.join("raytrace.png").exists());
+    assert_eq!(
+        files_in(&dir),
+        ["a.test", "b.test", "named.png", "raytrace.png", "x.png"],
+        "no stray temporary files"
+    );
+}
+
+#[test]
+fn stats_report_every_phase() {
+    let dir = workdir("stats");
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "--stats", "-o", "a.png"]);
+    let err = stderr(&o);
+    for phase in ["parse ", "build ", "render ", "write "] {
+        assert!(err.contains(phase), "{err}");
+    }
+}
+
+#[test]
+fn bad_input_exits_2_with_a_located_message_and_writes_nothing() {
+    let dir = workdir("bad");
+    fs::write(dir.join("bad.test"), format!("{SCENE}sphere 0 0 0 -2\n")).unwrap();
+    let o = lucent(&dir, &["render", "bad.test", "-o", "out.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = stderr(&o);
+    assert!(
+        err.starts_with("bad.test:11:14: error: sphere: radius must be positive, got -2\n"),
+        "{err}"
+    );
+    assert!(err.contains("11 | sphere 0 0 0 -2\n   |              ^~\n"), "{err}");
+    assert!(!dir.join("out.png").exists());
+}
+
+#[test]
+fn a_failed_run_leaves_an_existing_output_untouched() {
+    let dir = workdir("keep");
+    fs::write(dir.join("out.png"), b"precious").unwrap();
+    fs::write(dir.join("bad.test"), format!("{SCENE}tri 0 1 7\n")).unwrap();
+    assert_eq!(
+        lucent(&dir, &["render", "bad.test", "-o", "out.png"]).status.code(),
+        Some(2)
+    );
+    assert_eq!(fs::read(dir.join("out.png")).unwrap(), b"precious");
+    assert_eq!(files_in(&dir), ["bad.test", "out.png"]);
+}
+
+#[test]
+fn missing_scene_and_unwritable_output() {
+    let dir = workdir("missing");
+    let o = lucent(&dir, &["render", "nope.test"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).starts_with("nope.test:1:1: error: cannot read scene file: no such file"),
+        "{}",
+        stderr(&o)
+    );
+
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "-o", "no/such/dir/out.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("error: cannot write no/such/dir/out.png: no such file"),
+        "{}",
+        stderr(&o)
+    );
+    fs::create_dir(dir.join("adir.png")).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "-o", "adir.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("it is a directory"), "{}", stderr(&o));
+}
+
+#[test]
+fn garbage_never_panics() {
+    let dir = workdir("garbage");
+    let blob: Vec<u8> = (0..50_000u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 11) as u8)
+        .collect();
+    fs::write(dir.join("g.test"), &blob).unwrap();
+    let o = lucent(&dir, &["render", "g.test"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("g.test:1:"));
+    assert!(!stderr(&o).contains("panicked"));
+}
+
+#[test]
+fn strict_mode_turns_unknown_commands_into_errors() {
+    let dir = workdir("strict");
+    fs::write(dir.join("a.test"), format!("{SCENE}frobnicate 1 2\n")).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "-o", "a.png"]);
+    assert!(o.status.success());
+    assert!(stderr(&o).contains("a.test:11:1: warning: unknown command 'frobnicate' ignored"));
+    let o = lucent(&dir, &["render", "a.test", "-o", "b.png", "--strict"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("a.test:11:1: error: unknown command 'frobnicate'"));
+    assert!(!dir.join("b.png").exists());
+}
+
+#[test]
+fn check_summarises_and_reports_errors_like_render() {
+    let dir = workdir("check");
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    let o = lucent(&dir, &["check", "a.test"]);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("size:       32 x 24"), "{out}");
+    assert!(out.contains("objects:    1 spheres, 1 triangles"), "{out}");
+    assert!(out.contains("lights:     1 point, 0 directional, 0 quad"), "{out}");
+    fs::write(dir.join("bad.test"), "size 10 10\npopTransform\n").unwrap();
+    let o = lucent(&dir, &["check", "bad.test"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bad.test:2:1: error: popTransform: transform stack is empty"));
+    assert!(stderr(&o).contains("bad.test:2:1: error: the scene has no 'camera' command"));
+}
+
+#[test]
+fn same_bytes_for_any_thread_count_and_structure() {
+    let dir = workdir("same");
+    let mut scene = String::from(SCENE);
+    for k in 0..60 {
+        scene += &format!(
+            "specular 0.4 0.4 0.4\nsphere {} {} {} 0.3\n",
+            (k % 8) as f32 - 3.5,
+            (k / 8) as f32 * 0.4 - 1.0,
+            -(k % 5) as f32
+        );
+    }
+    fs::write(dir.join("s.test"), scene).unwrap();
+    for (name, args) in [
+        ("t1", vec!["--threads", "1"]),
+        ("t2", vec!["--threads", "2"]),
+        ("list", vec!["--accel", "list"]),
+    ] {
+        let out = format!("{name}.png");
+        let mut a = vec!["render", "s.test", "-q", "-o", &out];
+        a.extend(args);
+        assert!(lucent(&dir, &a).status.success());
+    }
+    let t1 = fs::read(dir.join("t1.png")).unwrap();
+    assert_eq!(t1, fs::read(dir.join("t2.png")).unwrap());
+    assert_eq!(t1, fs::read(dir.join("list.png")).unwrap());
+}
+
+#[test]
+fn diff_compares_images() {
+    let dir = workdir("diff");
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    assert!(lucent(&dir, &["render", "a.test", "-q", "-o", "a.png"])
+        .status
+        .success());
+    let o = lucent(&dir, &["diff", "a.png", "a.png", "--max-pixels", "0"]);
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).starts_with("pixels_over=0 pixels=768 "));
+}
