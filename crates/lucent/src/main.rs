@@ -1,6 +1,7 @@
 //! `lucent`: the command line. `render` makes a picture of a scene, `check` validates one
-//! and says what it holds, `diff` compares two images.
+//! and says what it holds, `diff` compares two images, `bench` measures speed.
 
+mod bench;
 mod check;
 mod diff;
 mod output;
@@ -33,6 +34,9 @@ enum Command {
     Check(check::CheckArgs),
     /// Compare two images (PNG or JPEG) pixel by pixel.
     Diff(diff::DiffArgs),
+    /// Benchmarks (figures for docs/performance.md).
+    #[command(subcommand)]
+    Bench(bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +45,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Diff(a) => diff::run(&a),
+        Command::Bench(c) => bench::run(&c),
     };
     ExitCode::from(code)
 }

@@ -1,0 +1,92 @@
+//! `lucent bench scene SCENE [--reps R] [--threads N] [--accel A]`: the whole-renderer
+//! benchmark. Parses and builds once, renders R times without writing, and prints one
+//! line with the median render time and rays per second. Speed is measured here, never
+//! asserted in tests.
+
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use clap::{Args, Subcommand};
+use lucent_core::accel::AccelKind;
+use lucent_core::render::{render, RenderControl};
+use lucent_io::build::{build, BuildOptions};
+use lucent_io::cse167::{parse_file, ParseOptions};
+
+use crate::output::report;
+use crate::EXIT_BAD_INPUT;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Render a scene several times and report the median time and Mrays/s.
+    Scene(SceneBenchArgs),
+}
+
+#[derive(Args)]
+pub struct SceneBenchArgs {
+    pub scene: PathBuf,
+    /// Renders to time (the median is reported).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub reps: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    #[arg(long, default_value = "bvh", value_parser = ["bvh", "list"])]
+    pub accel: String,
+}
+
+pub fn run(cmd: &BenchCommand) -> u8 {
+    match cmd {
+        BenchCommand::Scene(a) => scene(a),
+    }
+}
+
+fn scene(args: &SceneBenchArgs) -> u8 {
+    let accel: AccelKind = args.accel.parse().expect("clap checked the value");
+    let t0 = Instant::now();
+    let (desc, mut diags) = parse_file(&args.scene, ParseOptions::default());
+    let parse_s = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let built = if diags.has_errors() {
+        None
+    } else {
+        build(&desc, &BuildOptions { accel }, &mut diags)
+    };
+    let build_s = t1.elapsed().as_secs_f64();
+    report(&diags, &desc.sources, false);
+    let Some(built) = built else { return EXIT_BAD_INPUT };
+
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+        .expect("thread pool");
+    let cancel = AtomicBool::new(false);
+    let control = RenderControl {
+        progress: &|_| {},
+        cancel: &cancel,
+    };
+    let mut times = Vec::new();
+    let mut rays = 0;
+    for _ in 0..args.reps {
+        let t = Instant::now();
+        let (_, stats) = pool
+            .install(|| render(&built.scene, built.integrator.as_ref(), &control))
+            .expect("not cancelled");
+        times.push(t.elapsed().as_secs_f64());
+        rays = stats.rays;
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let name = args
+        .scene
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    println!(
+        "scene={name} accel={} threads={} parse_s={parse_s:.4} build_s={build_s:.4} render_s={median:.4} rays={rays} mrays_per_s={:.2} reps={}",
+        accel.name(),
+        pool.current_num_threads(),
+        rays as f64 / median / 1e6,
+        args.reps
+    );
+    0
+}
