@@ -5,6 +5,9 @@
 //! a description and builds a [`scene::Scene`] from it; this crate renders that scene.
 //! The path of one pixel can be read top-down in [`render`].
 
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod aabb;
 pub mod accel;
 pub mod camera;

@@ -5,6 +5,9 @@
 //! [`build::build`] turns that into a renderable [`lucent_core::scene::Scene`]. Problems
 //! found on the way are [`diag::Diagnostic`]s that point at the offending token.
 
+// `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod build;
 pub mod cse167;
 pub mod desc;

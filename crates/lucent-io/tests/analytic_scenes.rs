@@ -37,6 +37,7 @@ fn byte(c: f64) -> u8 {
 }
 
 /// The primary ray of SCENE_FORMAT.md §3.2 through the centre of pixel (j, i).
+#[allow(clippy::too_many_arguments)]
 fn camera_ray(eye: DVec3, at: DVec3, up: DVec3, fovy: f64, w: u32, h: u32, j: u32, i: u32) -> DVec3 {
     let wv = (eye - at).normalize();
     let u = up.cross(wv).normalize();

@@ -64,7 +64,8 @@ fn nearest_root(t0: f32, t1: f32, t_min: f32, t_max: f32) -> Option<f32> {
 mod tests {
     use super::*;
 
-    const BOTH: [fn(Vec3A, Vec3A, f32, f32) -> Option<f32>; 2] = [intersect_unit_algebraic, intersect_unit_geometric];
+    type Method = fn(Vec3A, Vec3A, f32, f32) -> Option<f32>;
+    const BOTH: [Method; 2] = [intersect_unit_algebraic, intersect_unit_geometric];
 
     #[test]
     fn head_on_hit_is_at_distance_minus_radius() {
