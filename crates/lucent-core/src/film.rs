@@ -21,10 +21,6 @@ impl Film {
         }
     }
 
-    pub fn get(&self, x: u32, y: u32) -> Color {
-        self.pixels[y as usize * self.width as usize + x as usize]
-    }
-
     /// Interleaved 8-bit RGB, top row first.
     pub fn to_rgb8(&self, gamma: f32) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.pixels.len() * 3);

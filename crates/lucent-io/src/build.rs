@@ -41,7 +41,6 @@ pub struct Built {
 
 /// Builds the scene, or returns `None` after adding errors to `diags`.
 pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) -> Option<Built> {
-    let errors_before = diags.count(crate::diag::Severity::Error);
     check_settings(desc, diags);
     let (Some(size), Some(cam)) = (&desc.size, &desc.camera) else {
         return None; // the parser has reported it
@@ -127,7 +126,7 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         }
     }
 
-    if diags.count(crate::diag::Severity::Error) > errors_before || diags.has_errors() {
+    if diags.has_errors() {
         return None;
     }
     let materials = desc.materials.iter().map(|m| m.base).collect();

@@ -305,8 +305,15 @@ impl Parser {
             "size" => self.size(c),
             "maxdepth" => {
                 if let Some([d]) = self.ints::<1>(c) {
-                    if d < -1 {
-                        self.err_arg(c, 0, format!("maxdepth: depth must be -1 (unbounded) or more, got {d}"));
+                    if d < -1 || d > i32::MAX as i64 {
+                        self.err_arg(
+                            c,
+                            0,
+                            format!(
+                                "maxdepth: depth must be -1 (unbounded) or between 0 and {}, got {d}",
+                                i32::MAX
+                            ),
+                        );
                     } else {
                         let v = Located {
                             value: d as i32,
@@ -858,18 +865,32 @@ impl Parser {
     }
 
     fn nums<const N: usize>(&mut self, c: &Command) -> Option<[f64; N]> {
+        self.args(c, "number", Self::number)
+    }
+
+    fn ints<const N: usize>(&mut self, c: &Command) -> Option<[i64; N]> {
+        self.args(c, "integer", Self::integer)
+    }
+
+    /// Exactly `N` arguments, each read by `parse`; every bad one is reported.
+    fn args<T: Copy + Default, const N: usize>(
+        &mut self,
+        c: &Command,
+        noun: &str,
+        parse: fn(&mut Self, &Command, &Token) -> Option<T>,
+    ) -> Option<[T; N]> {
         let what = if N == 1 {
-            "1 number".to_string()
+            format!("1 {noun}")
         } else {
-            format!("{N} numbers")
+            format!("{N} {noun}s")
         };
         if !self.expect_count(c, N, &what) {
             return None;
         }
-        let mut out = [0.0; N];
+        let mut out = [T::default(); N];
         let mut ok = true;
         for (k, tok) in c.args.iter().enumerate() {
-            match self.number(c, tok) {
+            match parse(self, c, tok) {
                 Some(x) => out[k] = x,
                 None => ok = false,
             }
@@ -878,55 +899,41 @@ impl Parser {
     }
 
     fn number(&mut self, c: &Command, tok: &Token) -> Option<f64> {
+        let loc = self.loc(c.line, tok);
         if !is_decimal(tok.text) {
-            let loc = self.loc(c.line, tok);
             self.diags
                 .error(loc, format!("{}: '{}' is not a number", c.name.text, tok.text));
             return None;
         }
-        let x: f64 = tok.text.parse().ok()?;
-        if !x.is_finite() || x.abs() > f32::MAX as f64 {
-            let loc = self.loc(c.line, tok);
-            self.diags
-                .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
-            return None;
+        match tok.text.parse::<f64>() {
+            Ok(x) if x.is_finite() && x.abs() <= f32::MAX as f64 => Some(x),
+            _ => {
+                self.diags
+                    .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
+                None
+            }
         }
-        Some(x)
     }
 
-    fn ints<const N: usize>(&mut self, c: &Command) -> Option<[i64; N]> {
-        let what = if N == 1 {
-            "1 integer".to_string()
-        } else {
-            format!("{N} integers")
-        };
-        if !self.expect_count(c, N, &what) {
+    fn integer(&mut self, c: &Command, tok: &Token) -> Option<i64> {
+        let loc = self.loc(c.line, tok);
+        if !is_integer(tok.text) {
+            let what = if is_decimal(tok.text) {
+                "is not an integer"
+            } else {
+                "is not a number"
+            };
+            self.diags.error(loc, format!("{}: '{}' {what}", c.name.text, tok.text));
             return None;
         }
-        let mut out = [0; N];
-        let mut ok = true;
-        for (k, tok) in c.args.iter().enumerate() {
-            let loc = self.loc(c.line, tok);
-            if !is_integer(tok.text) {
-                let msg = if is_decimal(tok.text) {
-                    "is not an integer"
-                } else {
-                    "is not a number"
-                };
-                self.diags.error(loc, format!("{}: '{}' {msg}", c.name.text, tok.text));
-                ok = false;
-                continue;
-            }
-            match tok.text.parse::<i64>() {
-                Ok(v) if v.unsigned_abs() <= u32::MAX as u64 * 4 => out[k] = v,
-                _ => {
-                    self.diags
-                        .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
-                    ok = false;
-                }
+        match tok.text.parse::<i64>() {
+            Ok(v) => Some(v),
+            Err(_) => {
+                self.diags
+                    .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
+                None
             }
         }
-        ok.then_some(out)
     }
 
     fn keyword<T: Copy>(&mut self, c: &Command, options: &[(&str, T)]) -> Option<T> {

@@ -41,10 +41,6 @@ impl SourceMap {
         let f = self.files.get(loc.file as usize)?;
         f.lines.get((loc.line as usize).checked_sub(1)?).map(|s| s.as_str())
     }
-
-    pub fn line_count(&self, file: u32) -> usize {
-        self.files.get(file as usize).map_or(0, |f| f.lines.len())
-    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -117,13 +113,6 @@ impl Diagnostics {
 
     pub fn too_many_errors(&self) -> bool {
         self.suppressed_errors > 0 || self.count(Severity::Error) >= MAX_ERRORS
-    }
-
-    pub fn extend(&mut self, other: Diagnostics) {
-        for d in other.items {
-            self.push(d.severity, d.loc, d.message);
-        }
-        self.suppressed_errors += other.suppressed_errors;
     }
 
     /// All diagnostics, each with its source line and caret, in the order found.

@@ -207,6 +207,14 @@ fn mirror_bounces_count_to_maxdepth() {
         );
         assert_eq!(pixel(&img, 5, 5), [want; 3], "maxdepth {depth}");
     }
+    // A huge depth between facing mirrors must end (no recursion that could exhaust a
+    // thread's stack) and converge to 0.1 · 2 = 0.2 → 51.
+    let img = render_bytes(
+        &format!("size 1 1\ncamera 0 0 5 0 0 0 0 1 0 30\nmaxdepth 200000\n{mirrors}"),
+        AccelKind::Bvh,
+        1,
+    );
+    assert_close(pixel(&img, 0, 0), [51; 3], "maxdepth 200000");
 }
 
 #[test]

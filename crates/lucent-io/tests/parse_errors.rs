@@ -116,7 +116,7 @@ fn impossible_values() {
     );
     assert_eq!(
         first_error("maxdepth -2"),
-        "t.test:3:10: error: maxdepth: depth must be -1 (unbounded) or more, got -2"
+        "t.test:3:10: error: maxdepth: depth must be -1 (unbounded) or between 0 and 2147483647, got -2"
     );
     assert_eq!(
         first_error("shininess -3"),

@@ -9,7 +9,6 @@ use lucent_core::accel::AccelKind;
 use lucent_core::render::{render, RenderControl};
 use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_file, ParseOptions};
-use lucent_io::diag::Diagnostics;
 use lucent_io::image::{check_writable, write_png};
 
 use crate::output::{choose_output, report};
@@ -71,7 +70,6 @@ pub fn run(args: &RenderArgs) -> u8 {
     let Some(built) = built else {
         return EXIT_BAD_INPUT;
     };
-    diags = Diagnostics::default();
 
     let pool = match rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
@@ -111,7 +109,6 @@ pub fn run(args: &RenderArgs) -> u8 {
         return EXIT_BAD_INPUT;
     }
     let t_written = Instant::now();
-    drop(diags);
 
     let render_s = (t_rendered - t_render).as_secs_f64();
     if !args.quiet {

@@ -12,7 +12,7 @@
 //! specular term is not gated by `N·L`.
 
 use super::Integrator;
-use crate::hit::BACKGROUND;
+use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::math::Color;
 use crate::ray::{Ray, EPSILON};
 use crate::scene::Scene;
@@ -23,17 +23,16 @@ pub struct Whitted {
 }
 
 impl Whitted {
-    fn trace(&self, scene: &Scene, ray: &Ray, depth: u32, rays: &mut u64) -> Color {
+    /// The local terms at the closest hit of `ray` (ambient, emission, lights), the hit,
+    /// and its normal; `None` when the ray escapes.
+    fn shade(&self, scene: &Scene, ray: &Ray, rays: &mut u64) -> Option<(Color, SurfacePoint)> {
         *rays += 1;
-        let Some(hit) = scene.closest_hit(ray) else {
-            return BACKGROUND;
-        };
+        let hit = scene.closest_hit(ray)?;
         let sp = scene.surface_point(&hit, ray);
         let m = &scene.materials[sp.material as usize];
         let n = sp.normal;
         let view = -ray.dir;
         let mut color = m.ambient + m.emission;
-
         for light in &scene.lights {
             let inc = light.incidence(sp.point);
             let n_dot_l = n.dot(inc.dir).max(0.0);
@@ -49,18 +48,30 @@ impl Whitted {
                 color += inc.intensity * reflected;
             }
         }
-
-        if depth < self.max_depth && m.specular != Color::ZERO {
-            let d = ray.dir;
-            let r = (d - n * (2.0 * d.dot(n))).normalize();
-            color += m.specular * self.trace(scene, &Ray::new(sp.point, r), depth + 1, rays);
-        }
-        color
+        Some((color, sp))
     }
 }
 
 impl Integrator for Whitted {
+    /// The mirror chain `I0 + S0 (I1 + S1 (I2 + …))` as a loop: the product of the
+    /// specular colours so far weights each hit's local terms. No recursion, so no
+    /// `maxdepth` can exhaust a thread's stack.
     fn radiance(&self, scene: &Scene, ray: &Ray, rays: &mut u64) -> Color {
-        self.trace(scene, ray, 0, rays)
+        let mut total = BACKGROUND;
+        let mut weight = Color::ONE;
+        let mut ray = *ray;
+        let mut depth = 0;
+        while let Some((local, sp)) = self.shade(scene, &ray, rays) {
+            total += weight * local;
+            let specular = scene.materials[sp.material as usize].specular;
+            if depth >= self.max_depth || specular == Color::ZERO {
+                break;
+            }
+            weight *= specular;
+            let (d, n) = (ray.dir, sp.normal);
+            ray = Ray::new(sp.point, (d - n * (2.0 * d.dot(n))).normalize());
+            depth += 1;
+        }
+        total
     }
 }
