@@ -198,6 +198,17 @@ fn same_bytes_for_any_thread_count_and_structure() {
 }
 
 #[test]
+fn an_empty_scene_renders_black() {
+    let dir = workdir("empty");
+    fs::write(dir.join("e.test"), "size 8 6\ncamera 0 0 -1 0 0 1 0 1 0 60\n").unwrap();
+    let o = lucent(&dir, &["render", "e.test", "-o", "e.png"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = lucent(&dir, &["render", "e.test", "-o", "l.png", "--accel", "list"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(fs::read(dir.join("e.png")).unwrap(), fs::read(dir.join("l.png")).unwrap());
+}
+
+#[test]
 fn diff_compares_images() {
     let dir = workdir("diff");
     fs::write(dir.join("a.test"), SCENE).unwrap();

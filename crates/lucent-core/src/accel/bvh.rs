@@ -387,10 +387,12 @@ mod tests {
     fn degenerate_inputs() {
         // Empty scene, a single primitive, identical primitives, zero-area triangles.
         let none: Vec<Primitive> = Vec::new();
-        let ray = Ray::segment(Vec3A::ZERO, Vec3A::Z, 1e-4, f32::INFINITY);
         let bvh = Bvh::build(&none);
-        assert!(bvh.closest_hit(&none, &ray).is_none());
-        assert!(!bvh.occluded(&none, &ray));
+        for o in [Vec3A::ZERO, Vec3A::new(0.0, 0.0, -1.0)] {
+            let ray = Ray::segment(o, Vec3A::Z, 1e-4, f32::INFINITY);
+            assert!(bvh.closest_hit(&none, &ray).is_none());
+            assert!(!bvh.occluded(&none, &ray));
+        }
 
         let mut prims = soup(7, 1);
         prims.extend(std::iter::repeat_n(prims[0], 40));
