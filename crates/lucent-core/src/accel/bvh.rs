@@ -70,7 +70,10 @@ impl Bvh {
             indices: (0..prims.len() as u32).collect(),
             nodes: Vec::with_capacity(2 * prims.len().max(1)),
         };
-        b.build_node(0, prims.len(), 0);
+        // No primitives, no nodes: a lone node with count 0 would read as interior.
+        if !prims.is_empty() {
+            b.build_node(0, prims.len(), 0);
+        }
         Bvh {
             nodes: b.nodes,
             indices: b.indices,
