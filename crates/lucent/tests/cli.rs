@@ -205,7 +205,10 @@ fn an_empty_scene_renders_black() {
     assert!(o.status.success(), "{}", stderr(&o));
     let o = lucent(&dir, &["render", "e.test", "-o", "l.png", "--accel", "list"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_eq!(fs::read(dir.join("e.png")).unwrap(), fs::read(dir.join("l.png")).unwrap());
+    assert_eq!(
+        fs::read(dir.join("e.png")).unwrap(),
+        fs::read(dir.join("l.png")).unwrap()
+    );
 }
 
 #[test]
