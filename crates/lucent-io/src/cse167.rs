@@ -564,26 +564,18 @@ impl Parser {
                 }
             }
             "roughness" => {
-                if let Some([a]) = self.nums::<1>(c) {
-                    if a <= 0.0 {
-                        self.err_arg(c, 0, format!("roughness: must be positive, got {}", c.args[0].text));
-                    } else {
-                        self.material.roughness = a;
-                        self.material_id = None;
-                    }
+                if let Some(a) = self.positive(c) {
+                    self.material.roughness = a;
+                    self.material_id = None;
                 }
             }
             "gamma" => {
-                if let Some([g]) = self.nums::<1>(c) {
-                    if g <= 0.0 {
-                        self.err_arg(c, 0, format!("gamma: must be positive, got {}", c.args[0].text));
-                    } else {
-                        let v = Located {
-                            value: g,
-                            loc: self.loc(c.line, &c.name),
-                        };
-                        self.set_global(c, |d| &mut d.gamma, v);
-                    }
+                if let Some(g) = self.positive(c) {
+                    let v = Located {
+                        value: g,
+                        loc: self.loc(c.line, &c.name),
+                    };
+                    self.set_global(c, |d| &mut d.gamma, v);
                 }
             }
             name if NOT_YET_IMPLEMENTED.contains(&name) => {
@@ -934,6 +926,20 @@ impl Parser {
                 None
             }
         }
+    }
+
+    /// The single argument of `c`, which must be a number > 0.
+    fn positive(&mut self, c: &Command) -> Option<f64> {
+        let [x] = self.nums::<1>(c)?;
+        if x > 0.0 {
+            return Some(x);
+        }
+        self.err_arg(
+            c,
+            0,
+            format!("{}: must be positive, got {}", c.name.text, c.args[0].text),
+        );
+        None
     }
 
     fn keyword<T: Copy>(&mut self, c: &Command, options: &[(&str, T)]) -> Option<T> {
