@@ -3,7 +3,7 @@
 //! leaves a partial image and never destroys an existing one.
 
 use std::fs::{self, File};
-use std::io::BufWriter;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use image::ImageEncoder;
@@ -52,13 +52,21 @@ pub fn check_writable(path: &Path) -> Result<(), ImageError> {
 
 /// Writes 8-bit RGB as PNG, atomically.
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+    let mut png = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut png)
+        .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
+        .map_err(|e| write_error(path, e))?;
+    write_file_atomically(path, &png)
+}
+
+/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it over
+/// `path`: readers see the old file or the whole new one, never a part.
+pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
     let tmp = temp_path(path);
     let result = (|| {
         let file = File::create(&tmp).map_err(|e| io_write_error(path, &e))?;
         let mut out = BufWriter::new(file);
-        image::codecs::png::PngEncoder::new(&mut out)
-            .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
-            .map_err(|e| write_error(path, e))?;
+        out.write_all(bytes).map_err(|e| io_write_error(path, &e))?;
         let file = out.into_inner().map_err(|e| io_write_error(path, e.error()))?;
         file.sync_all().map_err(|e| io_write_error(path, &e))?;
         fs::rename(&tmp, path).map_err(|e| io_write_error(path, &e))

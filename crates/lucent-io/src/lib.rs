@@ -13,4 +13,5 @@ pub mod cse167;
 pub mod desc;
 pub mod diag;
 pub mod image;
+pub mod mesh;
 mod number;

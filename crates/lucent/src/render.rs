@@ -26,7 +26,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
     /// Acceleration structure.
-    #[arg(long, default_value = "bvh", value_parser = ["bvh", "list"])]
+    #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
     /// Treat unknown commands as errors.
     #[arg(long)]

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use clap::{Args, Subcommand};
+use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_core::render::{render, RenderControl};
 use lucent_io::build::{build, BuildOptions};
@@ -15,12 +15,6 @@ use lucent_io::cse167::{parse_file, ParseOptions};
 
 use crate::output::report;
 use crate::EXIT_BAD_INPUT;
-
-#[derive(Subcommand)]
-pub enum BenchCommand {
-    /// Render a scene several times and report the median time and Mrays/s.
-    Scene(SceneBenchArgs),
-}
 
 #[derive(Args)]
 pub struct SceneBenchArgs {
@@ -31,17 +25,11 @@ pub struct SceneBenchArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
-    #[arg(long, default_value = "bvh", value_parser = ["bvh", "list"])]
+    #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
 }
 
-pub fn run(cmd: &BenchCommand) -> u8 {
-    match cmd {
-        BenchCommand::Scene(a) => scene(a),
-    }
-}
-
-fn scene(args: &SceneBenchArgs) -> u8 {
+pub fn run(args: &SceneBenchArgs) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t0 = Instant::now();
     let (desc, mut diags) = parse_file(&args.scene, ParseOptions::default());
@@ -75,8 +63,7 @@ fn scene(args: &SceneBenchArgs) -> u8 {
         times.push(t.elapsed().as_secs_f64());
         rays = stats.rays;
     }
-    times.sort_by(f64::total_cmp);
-    let median = times[times.len() / 2];
+    let median = super::median(times);
     let name = args
         .scene
         .file_stem()

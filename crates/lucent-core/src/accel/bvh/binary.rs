@@ -1,0 +1,276 @@
+//! First stage of the BVH build: a binary tree by the binned surface area heuristic
+//! (Wald 2007), later collapsed into the wide tree ([`super::wide`]).
+//!
+//! At each node the primitive centroids are sorted into 16 bins along all three axes at
+//! once, the 15 candidate planes per axis are priced with
+//! `C_trav + (A_l·P(N_l) + A_r·P(N_r)) / A`, where `P(n) = ⌈n/4⌉` counts the four-wide
+//! packets a leaf of `n` primitives needs, and the node becomes a leaf when that is no
+//! cheaper than its own packets. Below depth 48 (only pathological inputs get there), and
+//! when no plane separates the centroids, nodes are split at the object median so the
+//! depth stays bounded. The build works on a flat array of 32-byte references that it
+//! partitions in place: no allocation per node and no indirection.
+
+use crate::aabb::Aabb;
+use crate::math::Vec3A;
+
+use super::packet::LANES;
+
+const BINS: usize = 16;
+/// Leaves hold at most this many primitives (two packets).
+pub const MAX_LEAF: usize = 8;
+/// Cost of one traversal step relative to one packet test.
+const TRAVERSAL_COST: f32 = 1.0;
+const MEDIAN_SPLIT_DEPTH: usize = 48;
+
+/// A primitive's box and index, as the builder moves them around.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct BuildRef {
+    pub lo: [f32; 3],
+    pub prim: u32,
+    pub hi: [f32; 3],
+    _pad: u32,
+}
+
+impl BuildRef {
+    pub fn new(b: &Aabb, prim: u32) -> BuildRef {
+        BuildRef {
+            lo: b.min.into(),
+            prim,
+            hi: b.max.into(),
+            _pad: 0,
+        }
+    }
+    #[inline(always)]
+    fn lo(&self) -> Vec3A {
+        Vec3A::from_array(self.lo)
+    }
+    #[inline(always)]
+    fn hi(&self) -> Vec3A {
+        Vec3A::from_array(self.hi)
+    }
+    /// Twice the centroid (the factor ½ cancels in every use).
+    #[inline(always)]
+    fn centroid2(&self) -> Vec3A {
+        self.lo() + self.hi()
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Kind {
+    Interior {
+        left: u32,
+        right: u32,
+    },
+    /// `refs[start..start + count]`.
+    Leaf {
+        start: u32,
+        count: u32,
+    },
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct BinaryNode {
+    pub bounds: Aabb,
+    pub kind: Kind,
+}
+
+/// The binary tree; `refs` is in leaf order. Node 0 is the root (absent when empty).
+pub struct BinaryTree {
+    pub nodes: Vec<BinaryNode>,
+    pub refs: Vec<BuildRef>,
+}
+
+#[inline(always)]
+fn packets(n: usize) -> f32 {
+    n.div_ceil(LANES) as f32
+}
+
+pub fn build(bounds: impl ExactSizeIterator<Item = Aabb>) -> BinaryTree {
+    let refs: Vec<BuildRef> = bounds.enumerate().map(|(i, b)| BuildRef::new(&b, i as u32)).collect();
+    let mut tree = BinaryTree {
+        nodes: Vec::with_capacity(refs.len() / 2 + 1),
+        refs,
+    };
+    if !tree.refs.is_empty() {
+        let (b, c) = range_bounds(&tree.refs);
+        let n = tree.refs.len();
+        build_node(&mut tree, 0, n, b, c, 0);
+    }
+    tree
+}
+
+/// Bounds of the boxes and of the doubled centroids of `refs`.
+fn range_bounds(refs: &[BuildRef]) -> (Aabb, Aabb) {
+    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    let (mut clo, mut chi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for r in refs {
+        lo = lo.min(r.lo());
+        hi = hi.max(r.hi());
+        let c = r.centroid2();
+        clo = clo.min(c);
+        chi = chi.max(c);
+    }
+    (Aabb { min: lo, max: hi }, Aabb { min: clo, max: chi })
+}
+
+fn build_node(tree: &mut BinaryTree, start: usize, end: usize, bounds: Aabb, cb: Aabb, depth: usize) -> u32 {
+    let me = tree.nodes.len();
+    tree.nodes.push(BinaryNode {
+        bounds,
+        kind: Kind::Leaf {
+            start: start as u32,
+            count: (end - start) as u32,
+        },
+    });
+    let count = end - start;
+    if count <= 1 {
+        return me as u32;
+    }
+    let split = if depth >= MEDIAN_SPLIT_DEPTH {
+        Some(median_split(&mut tree.refs[start..end], &cb))
+    } else {
+        match sah_split(&mut tree.refs[start..end], &bounds, &cb) {
+            Some(s) => Some(s),
+            None if count > MAX_LEAF => Some(median_split(&mut tree.refs[start..end], &cb)),
+            None => None,
+        }
+    };
+    let Some(split) = split else { return me as u32 };
+    let mid = start + split.mid;
+    let left = build_node(tree, start, mid, split.left.0, split.left.1, depth + 1);
+    let right = build_node(tree, mid, end, split.right.0, split.right.1, depth + 1);
+    tree.nodes[me].kind = Kind::Interior { left, right };
+    me as u32
+}
+
+struct Split {
+    mid: usize,
+    /// Box and centroid bounds of each side (so children need not scan again).
+    left: (Aabb, Aabb),
+    right: (Aabb, Aabb),
+}
+
+#[derive(Clone, Copy)]
+struct Bin {
+    lo: Vec3A,
+    hi: Vec3A,
+    count: u32,
+}
+
+const EMPTY_BIN: Bin = Bin {
+    lo: Vec3A::INFINITY,
+    hi: Vec3A::NEG_INFINITY,
+    count: 0,
+};
+
+fn area(lo: Vec3A, hi: Vec3A) -> f32 {
+    let e = (hi - lo).max(Vec3A::ZERO);
+    e.x * e.y + e.y * e.z + e.z * e.x
+}
+
+/// Partitions at the best SAH plane, or returns `None` when a leaf is cheaper (or no
+/// plane separates the centroids).
+fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
+    let count = refs.len();
+    let extent = cb.max - cb.min;
+    let lo = cb.min;
+    // Axes with no extent get scale 0: everything lands in bin 0 and no plane is priced.
+    let scale = Vec3A::select(
+        extent.cmpgt(Vec3A::ZERO),
+        Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / extent,
+        Vec3A::ZERO,
+    );
+    let mut bins = [[EMPTY_BIN; BINS]; 3];
+    for r in refs.iter() {
+        let b = ((r.centroid2() - lo) * scale).min(Vec3A::splat((BINS - 1) as f32));
+        let (rlo, rhi) = (r.lo(), r.hi());
+        for (axis, bin_axis) in bins.iter_mut().enumerate() {
+            let bin = &mut bin_axis[b[axis] as usize];
+            bin.lo = bin.lo.min(rlo);
+            bin.hi = bin.hi.max(rhi);
+            bin.count += 1;
+        }
+    }
+    let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, first bin on the right)
+    for axis in 0..3 {
+        if scale[axis] == 0.0 {
+            continue;
+        }
+        let bins = &bins[axis];
+        let mut right_cost = [0.0f32; BINS];
+        let (mut rlo, mut rhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
+        for k in (1..BINS).rev() {
+            rlo = rlo.min(bins[k].lo);
+            rhi = rhi.max(bins[k].hi);
+            n += bins[k].count as usize;
+            right_cost[k] = if n == 0 { f32::NAN } else { area(rlo, rhi) * packets(n) };
+        }
+        let (mut llo, mut lhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
+        for k in 1..BINS {
+            llo = llo.min(bins[k - 1].lo);
+            lhi = lhi.max(bins[k - 1].hi);
+            n += bins[k - 1].count as usize;
+            let cost = area(llo, lhi) * packets(n) + right_cost[k];
+            // An empty side (NaN cost) is no split.
+            if n > 0 && !cost.is_nan() && best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, k));
+            }
+        }
+    }
+    let (cost, axis, split_bin) = best?;
+    let a = area(bounds.min, bounds.max);
+    let split_cost = TRAVERSAL_COST + if a > 0.0 { cost / a } else { packets(count) };
+    if count <= MAX_LEAF && split_cost >= packets(count) {
+        return None;
+    }
+    let (lo_a, scale_a) = (lo[axis], scale[axis]);
+    let goes_left = |r: &BuildRef| {
+        let b = ((r.lo[axis] + r.hi[axis] - lo_a) * scale_a).min((BINS - 1) as f32) as usize;
+        b < split_bin
+    };
+    let mid = partition(refs, goes_left);
+    if mid == 0 || mid == count {
+        return None;
+    }
+    Some(Split {
+        mid,
+        left: range_bounds(&refs[..mid]),
+        right: range_bounds(&refs[mid..]),
+    })
+}
+
+/// Splits in the middle by centroid along the widest axis (ties by index).
+fn median_split(refs: &mut [BuildRef], cb: &Aabb) -> Split {
+    let axis = cb.largest_axis();
+    let mid = refs.len() / 2;
+    refs.select_nth_unstable_by(mid, |a, b| {
+        (a.lo[axis] + a.hi[axis])
+            .total_cmp(&(b.lo[axis] + b.hi[axis]))
+            .then(a.prim.cmp(&b.prim))
+    });
+    Split {
+        mid,
+        left: range_bounds(&refs[..mid]),
+        right: range_bounds(&refs[mid..]),
+    }
+}
+
+/// In-place partition (Hoare style); returns how many elements satisfy `pred`.
+fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
+    let (mut i, mut j) = (0, v.len());
+    loop {
+        while i < j && pred(&v[i]) {
+            i += 1;
+        }
+        while i < j && !pred(&v[j - 1]) {
+            j -= 1;
+        }
+        if i >= j {
+            return i;
+        }
+        v.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
+}

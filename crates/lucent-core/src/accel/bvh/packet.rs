@@ -1,0 +1,256 @@
+//! Leaf data of the wide BVH: primitives in packets of four, triangles stored as
+//! structure-of-arrays so that one SSE instruction works on four of them.
+//!
+//! The packet test is the scalar watertight test of [`crate::shape::triangle::intersect`]
+//! done four lanes at a time with the same operations in the same order (no fused
+//! multiply–add), so it returns the same `t`, `b1`, `b2` to the bit — which is what lets
+//! the BVH agree exactly with the brute-force list. Lanes whose edge functions round to
+//! zero take the scalar path (and its f64 fallback). Non-triangle primitives (spheres)
+//! sit in a packet as a flagged index with NaN corners and are tested by the scalar
+//! primitive code; unused lanes hold NaN corners, which no test accepts.
+
+use crate::hit::Hit;
+use crate::primitive::{Primitive, Shape};
+use crate::ray::PreparedRay;
+use crate::shape::triangle;
+
+pub const LANES: usize = 4;
+/// Marks a lane whose primitive is not a triangle.
+const OTHER: u32 = 1 << 31;
+/// An unused lane (no high bit, so it is skipped by the `OTHER` check for free).
+const UNUSED: u32 = OTHER - 1;
+
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct Packet {
+    /// `p[corner][axis][lane]`.
+    p: [[[f32; LANES]; 3]; 3],
+    /// Primitive index per lane; `OTHER` set for non-triangles, `UNUSED` for empty lanes.
+    ids: [u32; LANES],
+}
+
+impl Packet {
+    /// Packs up to four primitives.
+    pub fn new(prims: &[Primitive], ids: &[u32]) -> Packet {
+        debug_assert!(!ids.is_empty() && ids.len() <= LANES);
+        let mut pk = Packet {
+            p: [[[f32::NAN; LANES]; 3]; 3],
+            ids: [UNUSED; LANES],
+        };
+        for (lane, &id) in ids.iter().enumerate() {
+            match &prims[id as usize].shape {
+                Shape::Triangle { p, .. } => {
+                    for (corner, v) in p.iter().enumerate() {
+                        for axis in 0..3 {
+                            pk.p[corner][axis][lane] = v[axis];
+                        }
+                    }
+                    pk.ids[lane] = id;
+                }
+                _ => pk.ids[lane] = id | OTHER,
+            }
+        }
+        pk
+    }
+
+    /// Scene index of the primitive in `lane`, if the lane is used.
+    #[cfg(test)]
+    pub fn prim(&self, lane: usize) -> Option<u32> {
+        (self.ids[lane] != UNUSED).then_some(self.ids[lane] & !OTHER)
+    }
+
+    /// Updates `best` (and `t_max`, the distance limit) with the closest hit in this packet.
+    #[inline(always)]
+    pub fn closest(&self, prims: &[Primitive], r: &PreparedRay, t_max: &mut f32, best: &mut Option<Hit>) {
+        let lanes = self.triangle_lanes(r, *t_max);
+        for lane in Lanes(lanes.mask) {
+            let (t, b1, b2) = (
+                lanes.t[lane],
+                lanes.v[lane] * lanes.inv_det[lane],
+                lanes.w[lane] * lanes.inv_det[lane],
+            );
+            self.record(t, lane, b1, b2, t_max, best);
+        }
+        for lane in Lanes(lanes.scalar) {
+            let id = self.ids[lane];
+            let hit = if id & OTHER != 0 {
+                prims[(id & !OTHER) as usize].intersect(r, *t_max)
+            } else {
+                self.scalar_triangle(r, lane, *t_max)
+            };
+            if let Some((t, b1, b2)) = hit {
+                self.record(t, lane, b1, b2, t_max, best);
+            }
+        }
+    }
+
+    /// Whether anything in this packet lies within `(t_min, t_max]`.
+    #[inline(always)]
+    pub fn any_hit(&self, prims: &[Primitive], r: &PreparedRay, t_max: f32) -> bool {
+        let lanes = self.triangle_lanes(r, t_max);
+        if lanes.mask != 0 {
+            return true;
+        }
+        Lanes(lanes.scalar).any(|lane| {
+            let id = self.ids[lane];
+            if id & OTHER != 0 {
+                prims[(id & !OTHER) as usize].intersect(r, t_max).is_some()
+            } else {
+                self.scalar_triangle(r, lane, t_max).is_some()
+            }
+        })
+    }
+
+    #[inline(always)]
+    fn record(&self, t: f32, lane: usize, b1: f32, b2: f32, t_max: &mut f32, best: &mut Option<Hit>) {
+        let prim = self.ids[lane] & !OTHER;
+        if Hit::is_closer_than(t, prim, best) {
+            *best = Some(Hit { t, prim, b1, b2 });
+            *t_max = t;
+        }
+    }
+
+    #[cold]
+    fn scalar_triangle(&self, r: &PreparedRay, lane: usize, t_max: f32) -> Option<(f32, f32, f32)> {
+        let corner = |c: usize| crate::math::Vec3A::new(self.p[c][0][lane], self.p[c][1][lane], self.p[c][2][lane]);
+        triangle::intersect(r, corner(0), corner(1), corner(2), t_max).map(|h| (h.t, h.b1, h.b2))
+    }
+
+    /// The SIMD part: accepted triangle lanes with their `t` and unnormalised
+    /// barycentrics, plus the lanes that need the scalar code.
+    #[inline(always)]
+    fn triangle_lanes(&self, r: &PreparedRay, t_max: f32) -> LaneHits {
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: SSE and SSE2 are part of the x86-64 baseline.
+            unsafe { self.triangle_lanes_sse(r, t_max) }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            self.triangle_lanes_portable(r, t_max)
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn triangle_lanes_sse(&self, r: &PreparedRay, t_max: f32) -> LaneHits {
+        use std::arch::x86_64::*;
+        let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+        let o = r.ray.origin;
+        let (ox, oy, oz) = (_mm_set1_ps(o[kx]), _mm_set1_ps(o[ky]), _mm_set1_ps(o[kz]));
+        let (sx, sy, sz) = (_mm_set1_ps(r.sx), _mm_set1_ps(r.sy), _mm_set1_ps(r.sz));
+        let ld = |c: usize, axis: usize| _mm_load_ps(self.p[c][axis].as_ptr());
+        // Translate to the ray origin and shear (the same operations as the scalar test).
+        let project = |c: usize| {
+            let dx = _mm_sub_ps(ld(c, kx), ox);
+            let dy = _mm_sub_ps(ld(c, ky), oy);
+            let dz = _mm_sub_ps(ld(c, kz), oz);
+            (
+                _mm_sub_ps(dx, _mm_mul_ps(sx, dz)),
+                _mm_sub_ps(dy, _mm_mul_ps(sy, dz)),
+                dz,
+            )
+        };
+        let (ax, ay, az) = project(0);
+        let (bx, by, bz) = project(1);
+        let (cx, cy, cz) = project(2);
+        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+        let zero = _mm_setzero_ps();
+        let any_zero = _mm_or_ps(
+            _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
+            _mm_cmpeq_ps(w, zero),
+        );
+        let neg = _mm_or_ps(
+            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
+            _mm_cmplt_ps(w, zero),
+        );
+        let pos = _mm_or_ps(
+            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
+            _mm_cmpgt_ps(w, zero),
+        );
+        let det = _mm_add_ps(_mm_add_ps(u, v), w);
+        let t_scaled = _mm_add_ps(
+            _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, az)), _mm_mul_ps(v, _mm_mul_ps(sz, bz))),
+            _mm_mul_ps(w, _mm_mul_ps(sz, cz)),
+        );
+        let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
+        let t = _mm_mul_ps(t_scaled, inv_det);
+        let inside = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpneq_ps(det, zero));
+        let in_range = _mm_and_ps(
+            _mm_cmpgt_ps(t, _mm_set1_ps(r.ray.t_min)),
+            _mm_cmple_ps(t, _mm_set1_ps(t_max)),
+        );
+        let mut scalar = _mm_movemask_ps(any_zero) as u32;
+        let mut mask = _mm_movemask_ps(_mm_and_ps(inside, in_range)) as u32 & !scalar;
+        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
+        if other != 0 {
+            // Flagged lanes are non-triangles (their NaN corners never set `mask`).
+            scalar |= other;
+            mask &= !other;
+        }
+        let mut hits = LaneHits {
+            mask,
+            scalar,
+            t: [0.0; LANES],
+            v: [0.0; LANES],
+            w: [0.0; LANES],
+            inv_det: [0.0; LANES],
+        };
+        if mask != 0 {
+            _mm_storeu_ps(hits.t.as_mut_ptr(), t);
+            _mm_storeu_ps(hits.v.as_mut_ptr(), v);
+            _mm_storeu_ps(hits.w.as_mut_ptr(), w);
+            _mm_storeu_ps(hits.inv_det.as_mut_ptr(), inv_det);
+        }
+        hits
+    }
+
+    #[cfg(not(target_arch = "x86_64"))]
+    fn triangle_lanes_portable(&self, r: &PreparedRay, t_max: f32) -> LaneHits {
+        // No SIMD here: every used lane goes through the scalar code.
+        let mut scalar = 0;
+        for lane in 0..LANES {
+            if self.ids[lane] != UNUSED {
+                scalar |= 1 << lane;
+            }
+        }
+        let _ = (r, t_max);
+        LaneHits {
+            mask: 0,
+            scalar,
+            t: [0.0; LANES],
+            v: [0.0; LANES],
+            w: [0.0; LANES],
+            inv_det: [0.0; LANES],
+        }
+    }
+}
+
+struct LaneHits {
+    /// Lanes whose triangle the SIMD test accepted.
+    mask: u32,
+    /// Lanes that must be tested by the scalar code.
+    scalar: u32,
+    t: [f32; LANES],
+    v: [f32; LANES],
+    w: [f32; LANES],
+    inv_det: [f32; LANES],
+}
+
+/// The set bits of a mask, lowest first.
+pub struct Lanes(pub u32);
+
+impl Iterator for Lanes {
+    type Item = usize;
+    #[inline(always)]
+    fn next(&mut self) -> Option<usize> {
+        if self.0 == 0 {
+            return None;
+        }
+        let i = self.0.trailing_zeros() as usize;
+        self.0 &= self.0 - 1;
+        Some(i)
+    }
+}

@@ -1,0 +1,137 @@
+//! Second stage of the BVH build: the binary tree collapsed into 8-wide nodes.
+//!
+//! Each wide node takes the place of a binary node and adopts its descendants: it starts
+//! with the two children and keeps opening the child with the largest surface area until
+//! it has eight (or only leaves are left). The node stores its children's boxes as
+//! structure-of-arrays, so one AVX instruction (or two SSE ones) tests all eight. Leaves
+//! become runs of four-wide packets, laid out in the order traversal meets them.
+
+use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
+use super::packet::{Packet, LANES};
+use crate::primitive::Primitive;
+
+pub const WIDTH: usize = 8;
+/// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`.
+pub const LEAF: u32 = 1 << 31;
+pub const PACKET_SHIFT: u32 = 28;
+pub const FIRST_MASK: u32 = (1 << PACKET_SHIFT) - 1;
+/// An unused slot; its box is empty (min > max), so no ray ever enters it.
+pub const EMPTY: u32 = 0;
+
+/// Eight child boxes and references. `bounds[0..3]` are the minima along x, y, z,
+/// `bounds[3..6]` the maxima; lane `i` belongs to child `i`.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct WideNode {
+    pub bounds: [[f32; WIDTH]; 6],
+    pub child: [u32; WIDTH],
+}
+
+const _: () = assert!(MAX_LEAF.div_ceil(LANES) <= 1 << (31 - PACKET_SHIFT));
+
+impl WideNode {
+    const EMPTY: WideNode = WideNode {
+        bounds: [
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
+        child: [EMPTY; WIDTH],
+    };
+}
+
+pub struct WideTree {
+    pub nodes: Vec<WideNode>,
+    pub packets: Vec<Packet>,
+}
+
+pub fn collapse(tree: &BinaryTree, prims: &[Primitive]) -> WideTree {
+    let mut out = WideTree {
+        nodes: Vec::with_capacity(tree.nodes.len() / 4 + 1),
+        packets: Vec::with_capacity(prims.len() / 3 + 1),
+    };
+    if let Some(root) = tree.nodes.first() {
+        match root.kind {
+            // A lone leaf still gets a node above it: traversal starts at a node.
+            Kind::Leaf { .. } => {
+                out.nodes.push(WideNode::EMPTY);
+                let slot = leaf_slot(tree, root, prims, &mut out);
+                set_child(&mut out.nodes[0], 0, root, slot);
+            }
+            Kind::Interior { .. } => {
+                collapse_node(tree, 0, prims, &mut out);
+            }
+        }
+    }
+    out
+}
+
+fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u32) {
+    let (lo, hi) = (child.bounds.min, child.bounds.max);
+    for axis in 0..3 {
+        node.bounds[axis][slot] = lo[axis];
+        node.bounds[axis + 3][slot] = hi[axis];
+    }
+    node.child[slot] = reference;
+}
+
+/// Emits the packets of a binary leaf; returns its slot reference.
+fn leaf_slot(tree: &BinaryTree, leaf: &BinaryNode, prims: &[Primitive], out: &mut WideTree) -> u32 {
+    let Kind::Leaf { start, count } = leaf.kind else {
+        unreachable!("a leaf")
+    };
+    let first = out.packets.len() as u32;
+    let ids: Vec<u32> = tree.refs[start as usize..(start + count) as usize]
+        .iter()
+        .map(|r| r.prim)
+        .collect();
+    for chunk in ids.chunks(LANES) {
+        out.packets.push(Packet::new(prims, chunk));
+    }
+    let n = out.packets.len() as u32 - first;
+    assert!(
+        first <= FIRST_MASK,
+        "too many primitives for the BVH's 28-bit packet index"
+    );
+    LEAF | (n - 1) << PACKET_SHIFT | first
+}
+
+/// Builds the wide node standing for interior binary node `b`; returns its index.
+fn collapse_node(tree: &BinaryTree, b: u32, prims: &[Primitive], out: &mut WideTree) -> u32 {
+    let Kind::Interior { left, right } = tree.nodes[b as usize].kind else {
+        unreachable!("interior")
+    };
+    let mut children = vec![left, right];
+    while children.len() < WIDTH {
+        // Open the interior child with the largest surface area.
+        let widest = children
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| matches!(tree.nodes[c as usize].kind, Kind::Interior { .. }))
+            .max_by(|(_, &a), (_, &c)| {
+                let area = |n: u32| tree.nodes[n as usize].bounds.surface_area();
+                area(a).total_cmp(&area(c))
+            })
+            .map(|(i, _)| i);
+        let Some(i) = widest else { break };
+        let Kind::Interior { left, right } = tree.nodes[children[i] as usize].kind else {
+            unreachable!()
+        };
+        children[i] = left;
+        children.insert(i + 1, right);
+    }
+    let me = out.nodes.len();
+    out.nodes.push(WideNode::EMPTY);
+    for (slot, &c) in children.iter().enumerate() {
+        let child = &tree.nodes[c as usize];
+        let reference = match child.kind {
+            Kind::Leaf { .. } => leaf_slot(tree, child, prims, out),
+            Kind::Interior { .. } => collapse_node(tree, c, prims, out),
+        };
+        set_child(&mut out.nodes[me], slot, child, reference);
+    }
+    me as u32
+}

@@ -1,0 +1,191 @@
+//! Property tests every structure must pass: the same closest hit and the same
+//! occlusion answer as the brute-force list, on random soups and degenerate input.
+
+use super::bvh::{Bvh, Isa};
+use super::list::PrimitiveList;
+use super::test_scenes::{coplanar_grid, soup, Rng};
+use super::{AccelKind, Accelerator};
+use crate::math::Vec3A;
+use crate::primitive::{Primitive, Shape};
+use crate::ray::Ray;
+
+/// Every structure, and the BVH with each box-test implementation this CPU can run.
+fn structures(prims: &[Primitive]) -> Vec<(String, Box<dyn Accelerator>)> {
+    let mut all: Vec<(String, Box<dyn Accelerator>)> = AccelKind::ALL
+        .iter()
+        .filter(|&&k| k != AccelKind::List)
+        .map(|&k| (k.name().to_string(), k.build(prims)))
+        .collect();
+    let mut isas = vec![Isa::Scalar];
+    #[cfg(target_arch = "x86_64")]
+    {
+        isas.push(Isa::Sse2);
+        if std::arch::is_x86_feature_detected!("avx2") {
+            isas.push(Isa::Avx2);
+        }
+    }
+    for isa in isas {
+        all.push((format!("bvh/{isa:?}"), Box::new(Bvh::build_for(prims, isa))));
+    }
+    all
+}
+
+/// Checks every structure against the list; returns how many rays hit something.
+fn check_against_list(prims: &[Primitive], rays: &[Ray]) -> usize {
+    let list = PrimitiveList::new(prims.len());
+    let expected: Vec<_> = rays
+        .iter()
+        .map(|r| (list.closest_hit(prims, r), list.occluded(prims, r)))
+        .collect();
+    for (name, accel) in structures(prims) {
+        for (ray, (hit, occluded)) in rays.iter().zip(&expected) {
+            assert_eq!(
+                accel.closest_hit(prims, ray),
+                *hit,
+                "{name}: closest hit differs for {ray:?}"
+            );
+            assert_eq!(
+                accel.occluded(prims, ray),
+                *occluded,
+                "{name}: occlusion differs for {ray:?}"
+            );
+        }
+    }
+    expected.iter().filter(|(h, _)| h.is_some()).count()
+}
+
+fn random_rays(rng: &mut Rng, n: usize, spread: f32, target: f32) -> Vec<Ray> {
+    (0..n)
+        .map(|_| {
+            let o = rng.vec(spread);
+            let d = (rng.vec(target) - o).normalize();
+            let t_max = if rng.next() < 0.3 {
+                rng.range(1.0, 2.0 * spread)
+            } else {
+                f32::INFINITY
+            };
+            Ray::segment(o, d, 1e-4, t_max)
+        })
+        .collect()
+}
+
+#[test]
+fn random_soups_match_the_list() {
+    for seed in 1..6 {
+        let prims = soup(seed, 700);
+        let rays = random_rays(&mut Rng(seed * 31), 3000, 15.0, 8.0);
+        assert!(check_against_list(&prims, &rays) > 500);
+    }
+}
+
+#[test]
+fn large_triangle_soup_matches_the_list() {
+    // Enough primitives for deep trees and full wide nodes.
+    let prims = soup(42, 20_000);
+    let rays = random_rays(&mut Rng(4242), 2000, 15.0, 8.0);
+    assert!(check_against_list(&prims, &rays) > 1000);
+}
+
+#[test]
+fn coplanar_grid_with_axis_parallel_rays_matches_the_list() {
+    let prims = coplanar_grid(20);
+    let mut rng = Rng(99);
+    // Rays straight down through vertices and edges (exact ties), and rays in the plane.
+    let mut rays: Vec<Ray> = (0..2000)
+        .map(|i| {
+            let (x, y) = if i % 2 == 0 {
+                ((i % 21) as f32, ((i / 21) % 21) as f32)
+            } else {
+                (rng.range(0.0, 20.0), rng.range(0.0, 20.0))
+            };
+            Ray::segment(Vec3A::new(x, y, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY)
+        })
+        .collect();
+    rays.extend((0..200).map(|i| Ray::segment(Vec3A::new(-1.0, i as f32 * 0.1, 0.0), Vec3A::X, 1e-4, f32::INFINITY)));
+    // Oblique rays through the grid's vertices.
+    rays.extend((0..400).map(|i| {
+        let p = Vec3A::new((i % 20) as f32, (i / 20) as f32, 0.0);
+        let d = Vec3A::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), -1.0).normalize();
+        Ray::segment(p - d * 3.0, d, 1e-4, f32::INFINITY)
+    }));
+    let hits = check_against_list(&prims, &rays);
+    assert!(hits >= 2300, "{hits}");
+}
+
+#[test]
+fn rays_starting_on_a_surface_match_the_list() {
+    // Secondary rays leave hit points, as the renderer's shadow and mirror rays do.
+    let prims = soup(8, 500);
+    let list = PrimitiveList::new(prims.len());
+    let mut rng = Rng(77);
+    let mut rays = Vec::new();
+    for r in random_rays(&mut rng, 3000, 15.0, 8.0) {
+        if let Some(h) = list.closest_hit(&prims, &r) {
+            let d = rng.vec(1.0).normalize();
+            rays.push(Ray::segment(r.at(h.t), d, 1e-4, f32::INFINITY));
+            rays.push(Ray::segment(r.at(h.t), d, 0.0, 5.0));
+        }
+    }
+    assert!(rays.len() > 500);
+    check_against_list(&prims, &rays);
+}
+
+#[test]
+fn degenerate_inputs_match_the_list() {
+    // Empty scene.
+    let none: Vec<Primitive> = Vec::new();
+    for o in [Vec3A::ZERO, Vec3A::new(0.0, 0.0, -1.0)] {
+        check_against_list(&none, &[Ray::segment(o, Vec3A::Z, 1e-4, f32::INFINITY)]);
+    }
+    // One primitive, many identical copies of it, and zero-area triangles.
+    let mut prims = soup(7, 1);
+    prims.extend(std::iter::repeat_n(prims[0], 40));
+    let p = Vec3A::new(1.0, 1.0, 1.0);
+    for q in [p, Vec3A::new(2.0, 2.0, 2.0)] {
+        prims.push(Primitive {
+            shape: Shape::Triangle {
+                p: [p, q, p],
+                normals: None,
+            },
+            material: 0,
+        });
+    }
+    let rays = random_rays(&mut Rng(5), 500, 15.0, 10.0);
+    check_against_list(&prims, &rays);
+    check_against_list(&prims[..1], &rays);
+
+    // Huge and tiny coordinates.
+    for scale in [1e6f32, 1e-6] {
+        let mut scaled = soup(3, 200);
+        for p in &mut scaled {
+            if let Shape::Triangle { p, .. } = &mut p.shape {
+                for v in p.iter_mut() {
+                    *v *= scale;
+                }
+            }
+        }
+        let rays: Vec<Ray> = random_rays(&mut Rng(8), 500, 15.0, 10.0)
+            .into_iter()
+            .map(|r| Ray::segment(r.origin * scale, r.dir, r.t_min * scale, r.t_max * scale))
+            .collect();
+        check_against_list(&scaled, &rays);
+    }
+}
+
+#[test]
+fn axis_parallel_rays_through_a_soup_match_the_list() {
+    let prims = soup(12, 800);
+    let mut rng = Rng(1212);
+    let mut rays = Vec::new();
+    for i in 0..3000 {
+        let axis = [Vec3A::X, Vec3A::Y, Vec3A::Z, -Vec3A::X, -Vec3A::Y, -Vec3A::Z][i % 6];
+        // Start on integer coordinates so that some origins lie exactly on box faces.
+        let o = if i % 2 == 0 {
+            rng.vec(12.0).round()
+        } else {
+            rng.vec(12.0)
+        };
+        rays.push(Ray::segment(o - axis * 15.0, axis, 1e-4, f32::INFINITY));
+    }
+    assert!(check_against_list(&prims, &rays) > 300);
+}

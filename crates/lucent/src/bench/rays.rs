@@ -1,0 +1,178 @@
+//! `lucent bench rays MESH.obj RAYS.bin [--accel A] [--threads N] [--reps R] [--occluded]
+//! [--hits OUT.bin]`: the ray–triangle kernel benchmark, run on the same files as the
+//! Embree harness in `../shared/bench/` (formats in its README).
+//!
+//! Ray files are 32-byte records of little-endian f32 `ox oy oz tnear dx dy dz tfar`.
+//! `--hits` writes 8 bytes per ray: f32 `t` and u32 triangle index (`inf`/`0xffffffff`
+//! for a miss); with `--occluded` `t` is 0 for an occluded ray and `inf` for a free one.
+//! One warm-up pass, then R timed passes; the last line reports medians.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use lucent_core::accel::{AccelKind, Accelerator};
+use lucent_core::math::Vec3A;
+use lucent_core::primitive::{Primitive, Shape};
+use lucent_core::ray::Ray;
+use lucent_io::image::write_file_atomically;
+use lucent_io::mesh::load_obj;
+use rayon::prelude::*;
+
+use crate::EXIT_BAD_INPUT;
+
+#[derive(Args)]
+pub struct RaysBenchArgs {
+    /// Triangle mesh (Wavefront OBJ; polygons are fan-triangulated in file order).
+    pub mesh: PathBuf,
+    /// Ray file: 32-byte records `ox oy oz tnear dx dy dz tfar` (little-endian f32).
+    pub rays: PathBuf,
+    #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
+    pub accel: String,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// Timed passes over the rays (the median is reported); builds are timed min(R, 3) times.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub reps: u32,
+    /// Any-hit queries (shadow rays) instead of closest hits.
+    #[arg(long)]
+    pub occluded: bool,
+    /// Write the answers here (8 bytes per ray).
+    #[arg(long, value_name = "OUT.bin")]
+    pub hits: Option<PathBuf>,
+}
+
+const RECORD: usize = 32;
+const MISS: u32 = u32::MAX;
+
+fn read_rays(path: &std::path::Path) -> Result<Vec<Ray>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read ray file: {e}", path.display()))?;
+    if bytes.len() % RECORD != 0 {
+        return Err(format!(
+            "{}: {} bytes is not a whole number of 32-byte ray records",
+            path.display(),
+            bytes.len()
+        ));
+    }
+    let rays: Vec<Ray> = bytes
+        .chunks_exact(RECORD)
+        .map(|r| {
+            let f = |k: usize| f32::from_le_bytes(r[4 * k..4 * k + 4].try_into().expect("4 bytes"));
+            Ray::segment(Vec3A::new(f(0), f(1), f(2)), Vec3A::new(f(4), f(5), f(6)), f(3), f(7))
+        })
+        .collect();
+    if let Some(k) = rays
+        .iter()
+        .position(|r| !r.origin.is_finite() || !r.dir.is_finite() || r.t_min.is_nan() || r.t_max.is_nan())
+    {
+        return Err(format!(
+            "{}: ray {k} has a NaN or infinite origin or direction",
+            path.display()
+        ));
+    }
+    Ok(rays)
+}
+
+/// One query: `(t, triangle)` as the answer file stores it.
+#[inline(always)]
+fn answer(accel: &dyn Accelerator, prims: &[Primitive], ray: &Ray, occluded: bool) -> (f32, u32) {
+    if occluded {
+        if accel.occluded(prims, ray) {
+            (0.0, 0)
+        } else {
+            (f32::INFINITY, 0)
+        }
+    } else {
+        match accel.closest_hit(prims, ray) {
+            Some(h) => (h.t, h.prim),
+            None => (f32::INFINITY, MISS),
+        }
+    }
+}
+
+pub fn run(args: &RaysBenchArgs) -> u8 {
+    match bench(args) {
+        Ok(()) => 0,
+        Err(msg) => {
+            eprintln!("error: {msg}");
+            EXIT_BAD_INPUT
+        }
+    }
+}
+
+fn bench(args: &RaysBenchArgs) -> Result<(), String> {
+    let kind: AccelKind = args.accel.parse()?;
+    if let Some(out) = &args.hits {
+        lucent_io::image::check_writable(out).map_err(|e| e.to_string())?;
+    }
+    let mesh = load_obj(&args.mesh)?;
+    let rays = read_rays(&args.rays)?;
+    let prims: Vec<Primitive> = (0..mesh.triangles.len())
+        .map(|k| Primitive {
+            shape: Shape::Triangle {
+                p: mesh.corners(k),
+                normals: None,
+            },
+            material: 0,
+        })
+        .collect();
+
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0) as usize)
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
+
+    // Builds are single-threaded: time them outside the pool's parallelism.
+    let mut build_times = Vec::new();
+    let mut accel = None;
+    for _ in 0..args.reps.min(3) {
+        drop(accel.take());
+        let t = Instant::now();
+        accel = Some(kind.build(&prims));
+        build_times.push(t.elapsed().as_secs_f64());
+    }
+    let accel = accel.expect("at least one build");
+    let build_s = super::median(build_times);
+
+    let mut answers = vec![(0.0f32, 0u32); rays.len()];
+    let trace = |answers: &mut [(f32, u32)]| {
+        const CHUNK: usize = 4096;
+        answers.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
+            let rays = &rays[c * CHUNK..];
+            for (a, ray) in out.iter_mut().zip(rays) {
+                *a = answer(accel.as_ref(), &prims, ray, args.occluded);
+            }
+        });
+    };
+    pool.install(|| trace(&mut answers)); // warm-up
+    let mut times = Vec::new();
+    for _ in 0..args.reps {
+        let t = Instant::now();
+        pool.install(|| trace(&mut answers));
+        times.push(t.elapsed().as_secs_f64());
+    }
+    let trace_s = super::median(times);
+    let hits = answers
+        .iter()
+        .filter(|&&(t, prim)| if args.occluded { t == 0.0 } else { prim != MISS })
+        .count();
+
+    if let Some(out) = &args.hits {
+        let bytes: Vec<u8> = answers
+            .iter()
+            .flat_map(|&(t, prim)| t.to_le_bytes().into_iter().chain(prim.to_le_bytes()))
+            .collect();
+        write_file_atomically(out, &bytes).map_err(|e| e.to_string())?;
+    }
+    println!(
+        "mrays_per_s={:.3} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} tris={} trace_s={trace_s:.4}",
+        rays.len() as f64 / trace_s / 1e6,
+        accel.memory_bytes() as f64 / prims.len().max(1) as f64,
+        rays.len(),
+        kind.name(),
+        pool.current_num_threads(),
+        prims.len(),
+    );
+    Ok(())
+}
