@@ -7,7 +7,9 @@
 //! `t` go to the primitive that comes first in the scene ([`Hit::is_closer_than`]).
 
 pub mod bvh;
+pub mod kdtree;
 pub mod list;
+pub mod overlap;
 #[cfg(test)]
 mod tests;
 
@@ -41,13 +43,14 @@ pub trait Accelerator: Send + Sync {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AccelKind {
     Bvh,
+    KdTree,
     List,
 }
 
 impl AccelKind {
-    pub const ALL: [AccelKind; 2] = [AccelKind::Bvh, AccelKind::List];
+    pub const ALL: [AccelKind; 3] = [AccelKind::Bvh, AccelKind::KdTree, AccelKind::List];
     /// The names `--accel` takes, in the order of [`AccelKind::ALL`].
-    pub const NAMES: [&'static str; 2] = ["bvh", "list"];
+    pub const NAMES: [&'static str; 3] = ["bvh", "kdtree", "list"];
 
     pub fn name(self) -> &'static str {
         AccelKind::NAMES[AccelKind::ALL
@@ -59,6 +62,7 @@ impl AccelKind {
     pub fn build(self, prims: &[Primitive]) -> Box<dyn Accelerator> {
         match self {
             AccelKind::Bvh => Box::new(bvh::Bvh::build(prims)),
+            AccelKind::KdTree => Box::new(kdtree::KdTree::build(prims)),
             AccelKind::List => Box::new(list::PrimitiveList::new(prims.len())),
         }
     }

@@ -59,7 +59,7 @@ impl BoxTest for Scalar {
     #[inline(always)]
     unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
         let mut mask = 0;
-        for i in 0..WIDTH {
+        for (i, d) in dist.iter_mut().enumerate() {
             let (mut near, mut far) = (r.t_min, f32::INFINITY);
             let mut inside = true;
             for a in 0..3 {
@@ -75,7 +75,7 @@ impl BoxTest for Scalar {
             }
             far *= FAR_WIDENING;
             far = if t_max < far { t_max } else { far };
-            dist[i] = near;
+            *d = near;
             if inside && near <= far {
                 mask |= 1 << i;
             }

@@ -1,0 +1,192 @@
+//! Which primitives a cell holds: the exact triangle–box overlap test (separating axis
+//! theorem, Akenine-Möller 2001) and triangle clipping to a box (the bounds of the part
+//! of a triangle inside a kd-tree node: "perfect splits", Havran 2000).
+//!
+//! Both work in f64 on cells padded by [`cell_padding`], so rounding can only put a
+//! primitive into a cell it merely touches, never leave it out of one it overlaps: a
+//! structure that leaves a primitive out of a cell the ray crosses would miss its hit.
+
+use crate::aabb::Aabb;
+use crate::math::{DVec3, Vec3A};
+use crate::primitive::{Primitive, Shape};
+
+/// How much cells grow before primitives are assigned to them: a small fraction of the
+/// scene's size, far above f32 rounding and far below any cell a build makes.
+pub fn cell_padding(scene: &Aabb) -> f32 {
+    let e = scene.extent().max_element();
+    let m = scene.min.abs().max(scene.max.abs()).max_element();
+    1e-5 * e + 1e-6 * m + f32::MIN_POSITIVE
+}
+
+pub fn padded(b: &Aabb, pad: f32) -> Aabb {
+    Aabb {
+        min: b.min - Vec3A::splat(pad),
+        max: b.max + Vec3A::splat(pad),
+    }
+}
+
+fn d(v: Vec3A) -> DVec3 {
+    DVec3::new(v.x as f64, v.y as f64, v.z as f64)
+}
+
+/// Whether a primitive overlaps box `b` (faces included). Exact for triangles; other
+/// shapes are represented by their bounding box.
+pub fn overlaps(prim: &Primitive, b: &Aabb) -> bool {
+    match &prim.shape {
+        Shape::Triangle { p, .. } => triangle_overlaps_box(p, b),
+        _ => boxes_overlap(&prim.bounds(), b),
+    }
+}
+
+pub fn boxes_overlap(a: &Aabb, b: &Aabb) -> bool {
+    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
+}
+
+/// Separating axis test: the triangle and the box are disjoint exactly when one of 13
+/// axes separates them — the box's three face normals, the triangle's normal, and the
+/// nine cross products of box edges with triangle edges.
+pub fn triangle_overlaps_box(p: &[Vec3A; 3], b: &Aabb) -> bool {
+    let c = (d(b.min) + d(b.max)) * 0.5;
+    let h = (d(b.max) - d(b.min)) * 0.5;
+    let v = [d(p[0]) - c, d(p[1]) - c, d(p[2]) - c];
+    // Box face normals: compare the triangle's bounds with the box.
+    for a in 0..3 {
+        let lo = v[0][a].min(v[1][a]).min(v[2][a]);
+        let hi = v[0][a].max(v[1][a]).max(v[2][a]);
+        if lo > h[a] || hi < -h[a] {
+            return false;
+        }
+    }
+    let e = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    let separates = |axis: DVec3| {
+        if axis == DVec3::ZERO {
+            return false; // parallel edges: covered by the other axes
+        }
+        let (p0, p1, p2) = (axis.dot(v[0]), axis.dot(v[1]), axis.dot(v[2]));
+        let r = h.x * axis.x.abs() + h.y * axis.y.abs() + h.z * axis.z.abs();
+        p0.min(p1).min(p2) > r || p0.max(p1).max(p2) < -r
+    };
+    if separates(e[0].cross(e[1])) {
+        return false;
+    }
+    for edge in e {
+        for unit in [DVec3::X, DVec3::Y, DVec3::Z] {
+            if separates(unit.cross(edge)) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Bounds of the part of the primitive inside `b`, or `None` if it does not overlap.
+/// Triangles are clipped (Sutherland–Hodgman against the six planes); other shapes
+/// use their bounding box cut to `b`.
+pub fn clipped_bounds(prim: &Primitive, b: &Aabb) -> Option<Aabb> {
+    match &prim.shape {
+        Shape::Triangle { p, .. } => clip_triangle(p, b),
+        _ => {
+            let pb = prim.bounds();
+            boxes_overlap(&pb, b).then(|| Aabb {
+                min: pb.min.max(b.min),
+                max: pb.max.min(b.max),
+            })
+        }
+    }
+}
+
+fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Aabb> {
+    let mut poly: Vec<DVec3> = p.iter().map(|&v| d(v)).collect();
+    let (lo, hi) = (d(b.min), d(b.max));
+    for axis in 0..3 {
+        for (plane, keep_above) in [(lo[axis], true), (hi[axis], false)] {
+            let inside = |q: &DVec3| if keep_above { q[axis] >= plane } else { q[axis] <= plane };
+            let mut out = Vec::with_capacity(poly.len() + 1);
+            for i in 0..poly.len() {
+                let (a, c) = (poly[i], poly[(i + 1) % poly.len()]);
+                if inside(&a) {
+                    out.push(a);
+                }
+                if inside(&a) != inside(&c) {
+                    let t = (plane - a[axis]) / (c[axis] - a[axis]);
+                    let mut q = a + (c - a) * t;
+                    q[axis] = plane;
+                    out.push(q);
+                }
+            }
+            poly = out;
+            if poly.is_empty() {
+                return None;
+            }
+        }
+    }
+    // The clipped bounds only place candidate split planes (which cell a primitive goes
+    // to is decided by `overlaps`), so rounding to nearest is fine; never beyond the box.
+    let mut r = Aabb::EMPTY;
+    for q in poly {
+        let q = Vec3A::new(q.x as f32, q.y as f32, q.z as f32);
+        r = r.grow(q);
+    }
+    Some(Aabb {
+        min: r.min.max(b.min),
+        max: r.max.min(b.max),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_scenes::Rng;
+    use super::*;
+
+    #[test]
+    fn clipping_and_the_separating_axis_test_agree() {
+        let mut rng = Rng(3);
+        let b = Aabb::new(Vec3A::splat(-1.0), Vec3A::splat(1.0));
+        let (mut inside, mut outside) = (0, 0);
+        for _ in 0..20_000 {
+            let c = rng.vec(2.5);
+            let p = [c + rng.vec(1.5), c + rng.vec(1.5), c + rng.vec(1.5)];
+            let sat = triangle_overlaps_box(&p, &b);
+            let clip = clip_triangle(&p, &b);
+            // Clipping can lose a sliver that only touches the box within rounding.
+            assert!(clip.is_none() || sat, "{p:?}");
+            if let Some(cb) = clip {
+                assert!(cb.min.cmpge(b.min).all() && cb.max.cmple(b.max).all());
+                inside += 1;
+            } else if !sat {
+                outside += 1;
+            }
+            // Brute force: sample the triangle; any sample in the box means overlap.
+            for k in 0..50 {
+                let (u, v) = (rng.next(), rng.next());
+                let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                let q = p[0] + (p[1] - p[0]) * u + (p[2] - p[0]) * v;
+                if q.cmpge(b.min).all() && q.cmple(b.max).all() {
+                    assert!(sat, "sample {k} of {p:?} is in the box but SAT says disjoint");
+                    assert!(clip.is_some_and(|cb| cb.min.cmple(q + 1e-5).all() && cb.max.cmpge(q - 1e-5).all()));
+                    break;
+                }
+            }
+        }
+        assert!(inside > 2000 && outside > 2000, "{inside} {outside}");
+    }
+
+    #[test]
+    fn a_triangle_near_a_box_corner_is_separated_by_an_edge_axis() {
+        // Its bounding box overlaps the unit box, but the triangle passes by the corner.
+        let b = Aabb::new(Vec3A::ZERO, Vec3A::ONE);
+        let p = [
+            Vec3A::new(2.0, 0.5, 0.5),
+            Vec3A::new(0.5, 2.0, 0.5),
+            Vec3A::new(2.0, 2.0, 0.5),
+        ];
+        assert!(!triangle_overlaps_box(&p, &b));
+        assert!(clip_triangle(&p, &b).is_none());
+        let touching = [
+            Vec3A::new(2.0, 0.0, 0.5),
+            Vec3A::new(0.0, 2.0, 0.5),
+            Vec3A::new(2.0, 2.0, 0.5),
+        ];
+        assert!(triangle_overlaps_box(&touching, &b));
+    }
+}
