@@ -7,8 +7,10 @@
 //! `t` go to the primitive that comes first in the scene ([`Hit::is_closer_than`]).
 
 pub mod bvh;
+pub mod grid;
 pub mod kdtree;
 pub mod list;
+mod mailbox;
 pub mod overlap;
 #[cfg(test)]
 mod tests;
@@ -44,13 +46,14 @@ pub trait Accelerator: Send + Sync {
 pub enum AccelKind {
     Bvh,
     KdTree,
+    Grid,
     List,
 }
 
 impl AccelKind {
-    pub const ALL: [AccelKind; 3] = [AccelKind::Bvh, AccelKind::KdTree, AccelKind::List];
+    pub const ALL: [AccelKind; 4] = [AccelKind::Bvh, AccelKind::KdTree, AccelKind::Grid, AccelKind::List];
     /// The names `--accel` takes, in the order of [`AccelKind::ALL`].
-    pub const NAMES: [&'static str; 3] = ["bvh", "kdtree", "list"];
+    pub const NAMES: [&'static str; 4] = ["bvh", "kdtree", "grid", "list"];
 
     pub fn name(self) -> &'static str {
         AccelKind::NAMES[AccelKind::ALL
@@ -63,6 +66,7 @@ impl AccelKind {
         match self {
             AccelKind::Bvh => Box::new(bvh::Bvh::build(prims)),
             AccelKind::KdTree => Box::new(kdtree::KdTree::build(prims)),
+            AccelKind::Grid => Box::new(grid::Grid::build(prims)),
             AccelKind::List => Box::new(list::PrimitiveList::new(prims.len())),
         }
     }

@@ -1,0 +1,225 @@
+//! Uniform grid (`--accel grid`).
+//!
+//! Build: the scene box (volume `V`) is cut into cells of equal size, `(λ·N / V)^(1/3)`
+//! per unit of length along every axis (λ = 3): about `λ·N` cells in all, so about
+//! `λ^(1/3)·N^(1/3)` per axis, more along the box's long sides. Each primitive is entered into every
+//! cell it overlaps — its bounding box picks the candidates, the exact triangle–box test
+//! decides — in one flat array with an offset per cell.
+//!
+//! Traversal: 3-D DDA (Amanatides & Woo 1987) from the cell where the ray enters, always
+//! stepping across the nearest cell wall, so cells are visited in ray order; the search
+//! ends when the closest hit lies inside the current cell. Mailboxing ([`Mailbox`])
+//! tests a primitive that spans several cells once per ray.
+
+use super::mailbox::Mailbox;
+use super::overlap::{cell_padding, overlaps, padded};
+use super::{search_limit, Accelerator};
+use crate::aabb::Aabb;
+use crate::hit::Hit;
+use crate::math::Vec3A;
+use crate::primitive::Primitive;
+use crate::ray::{PreparedRay, Ray};
+
+/// Cells per primitive.
+const DENSITY: f32 = 3.0;
+const MAX_RES: usize = 512;
+
+pub struct Grid {
+    bounds: Aabb,
+    res: [usize; 3],
+    cell_size: Vec3A,
+    /// Primitives of cell `c`: `prim_ids[cell_start[c]..cell_start[c + 1]]`.
+    cell_start: Vec<u32>,
+    prim_ids: Vec<u32>,
+    prim_count: usize,
+}
+
+impl Grid {
+    pub fn build(prims: &[Primitive]) -> Grid {
+        let scene = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()));
+        if prims.is_empty() {
+            return Grid {
+                bounds: Aabb::EMPTY,
+                res: [1; 3],
+                cell_size: Vec3A::ONE,
+                cell_start: vec![0, 0],
+                prim_ids: Vec::new(),
+                prim_count: 0,
+            };
+        }
+        let pad = cell_padding(&scene);
+        let bounds = padded(&scene, pad);
+        let ext = bounds.extent();
+        // Flat scenes have no volume: give thin axes a token thickness for the estimate.
+        let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3));
+        let per_unit = (DENSITY * prims.len() as f32 / (e.x * e.y * e.z)).cbrt();
+        let res = [0, 1, 2].map(|a| ((ext[a] * per_unit).round() as usize).clamp(1, MAX_RES));
+        let cell_size = ext / Vec3A::new(res[0] as f32, res[1] as f32, res[2] as f32);
+        let mut grid = Grid {
+            bounds,
+            res,
+            cell_size,
+            cell_start: Vec::new(),
+            prim_ids: Vec::new(),
+            prim_count: prims.len(),
+        };
+        // Two passes: count the entries of every cell, then fill them in.
+        let cells = res[0] * res[1] * res[2];
+        let mut count = vec![0u32; cells + 1];
+        grid.for_each_entry(prims, pad, |c, _| count[c] += 1);
+        let mut start = 0u32;
+        for c in count.iter_mut() {
+            let n = *c;
+            *c = start;
+            start += n;
+        }
+        let mut fill = count.clone();
+        let mut ids = vec![0u32; start as usize];
+        grid.for_each_entry(prims, pad, |c, p| {
+            ids[fill[c] as usize] = p;
+            fill[c] += 1;
+        });
+        grid.cell_start = count;
+        grid.prim_ids = ids;
+        grid
+    }
+
+    fn cell_of(&self, p: Vec3A, axis: usize) -> usize {
+        let x = ((p[axis] - self.bounds.min[axis]) / self.cell_size[axis]).floor();
+        (x.max(0.0) as usize).min(self.res[axis] - 1)
+    }
+
+    fn cell_box(&self, c: [usize; 3]) -> Aabb {
+        let lo = self.bounds.min + self.cell_size * Vec3A::new(c[0] as f32, c[1] as f32, c[2] as f32);
+        Aabb {
+            min: lo,
+            max: lo + self.cell_size,
+        }
+    }
+
+    fn index(&self, c: [usize; 3]) -> usize {
+        (c[2] * self.res[1] + c[1]) * self.res[0] + c[0]
+    }
+
+    /// Calls `f(cell, prim)` for every cell every primitive overlaps.
+    fn for_each_entry(&self, prims: &[Primitive], pad: f32, mut f: impl FnMut(usize, u32)) {
+        for (i, prim) in prims.iter().enumerate() {
+            let b = padded(&prim.bounds(), pad);
+            let lo = [0, 1, 2].map(|a| self.cell_of(b.min, a));
+            let hi = [0, 1, 2].map(|a| self.cell_of(b.max, a));
+            let single = lo == hi;
+            for z in lo[2]..=hi[2] {
+                for y in lo[1]..=hi[1] {
+                    for x in lo[0]..=hi[0] {
+                        let c = [x, y, z];
+                        if single || overlaps(prim, &padded(&self.cell_box(c), pad)) {
+                            f(self.index(c), i as u32);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    pub fn resolution(&self) -> [usize; 3] {
+        self.res
+    }
+
+    /// Visits the cells the ray crosses, in order; `cell` gets the cell's primitives
+    /// and returns the distance beyond which nothing more can be found (`None`: stop).
+    #[inline(always)]
+    fn walk(&self, ray: &Ray, mut cell: impl FnMut(&[u32]) -> Option<f32>) {
+        if self.prim_count == 0 {
+            return;
+        }
+        let r = PreparedRay::new(*ray);
+        let Some((t0, _)) = self.bounds.intersect(&r, search_limit(ray.t_max)) else {
+            return;
+        };
+        let entry = ray.at(t0);
+        let mut c = [0, 1, 2].map(|a| self.cell_of(entry, a));
+        let mut step = [0isize; 3];
+        let mut next_t = [f32::INFINITY; 3];
+        let wall = |c: usize, a: usize| self.bounds.min[a] + c as f32 * self.cell_size[a];
+        for a in 0..3 {
+            if ray.dir[a] > 0.0 {
+                step[a] = 1;
+                next_t[a] = (wall(c[a] + 1, a) - ray.origin[a]) * r.inv_dir[a];
+            } else if ray.dir[a] < 0.0 {
+                step[a] = -1;
+                next_t[a] = (wall(c[a], a) - ray.origin[a]) * r.inv_dir[a];
+            }
+        }
+        loop {
+            let i = self.index(c);
+            let ids = &self.prim_ids[self.cell_start[i] as usize..self.cell_start[i + 1] as usize];
+            let Some(limit) = cell(ids) else { return };
+            let a = if next_t[0] < next_t[1] {
+                if next_t[0] < next_t[2] {
+                    0
+                } else {
+                    2
+                }
+            } else if next_t[1] < next_t[2] {
+                1
+            } else {
+                2
+            };
+            let exit = next_t[a];
+            // The closest hit lies in this cell, or the ray ends in it.
+            if limit < exit || exit > search_limit(ray.t_max) {
+                return;
+            }
+            let n = c[a] as isize + step[a];
+            if n < 0 || n >= self.res[a] as isize {
+                return;
+            }
+            c[a] = n as usize;
+            let w = if step[a] > 0 { c[a] + 1 } else { c[a] };
+            next_t[a] = (wall(w, a) - ray.origin[a]) * r.inv_dir[a];
+        }
+    }
+}
+
+impl Accelerator for Grid {
+    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+        let r = PreparedRay::new(*ray);
+        let mut best: Option<Hit> = None;
+        let mut t_max = ray.t_max;
+        Mailbox::with(self.prim_count, |mailbox| {
+            self.walk(ray, |ids| {
+                for &pi in ids {
+                    if !mailbox.first_visit(pi) {
+                        continue;
+                    }
+                    if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
+                        if Hit::is_closer_than(t, pi, &best) {
+                            best = Some(Hit { t, prim: pi, b1, b2 });
+                            t_max = t;
+                        }
+                    }
+                }
+                Some(best.map_or(f32::INFINITY, |h| search_limit(h.t)))
+            })
+        });
+        best
+    }
+
+    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+        let r = PreparedRay::new(*ray);
+        let mut hit = false;
+        Mailbox::with(self.prim_count, |mailbox| {
+            self.walk(ray, |ids| {
+                hit = ids
+                    .iter()
+                    .any(|&pi| mailbox.first_visit(pi) && prims[pi as usize].intersect(&r, ray.t_max).is_some());
+                (!hit).then_some(f32::INFINITY)
+            })
+        });
+        hit
+    }
+
+    fn memory_bytes(&self) -> usize {
+        (self.cell_start.len() + self.prim_ids.len()) * 4
+    }
+}
