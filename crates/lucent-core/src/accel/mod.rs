@@ -11,6 +11,7 @@ pub mod grid;
 pub mod kdtree;
 pub mod list;
 mod mailbox;
+pub mod octree;
 pub mod overlap;
 #[cfg(test)]
 mod tests;
@@ -47,13 +48,20 @@ pub enum AccelKind {
     Bvh,
     KdTree,
     Grid,
+    Octree,
     List,
 }
 
 impl AccelKind {
-    pub const ALL: [AccelKind; 4] = [AccelKind::Bvh, AccelKind::KdTree, AccelKind::Grid, AccelKind::List];
+    pub const ALL: [AccelKind; 5] = [
+        AccelKind::Bvh,
+        AccelKind::KdTree,
+        AccelKind::Grid,
+        AccelKind::Octree,
+        AccelKind::List,
+    ];
     /// The names `--accel` takes, in the order of [`AccelKind::ALL`].
-    pub const NAMES: [&'static str; 4] = ["bvh", "kdtree", "grid", "list"];
+    pub const NAMES: [&'static str; 5] = ["bvh", "kdtree", "grid", "octree", "list"];
 
     pub fn name(self) -> &'static str {
         AccelKind::NAMES[AccelKind::ALL
@@ -67,6 +75,7 @@ impl AccelKind {
             AccelKind::Bvh => Box::new(bvh::Bvh::build(prims)),
             AccelKind::KdTree => Box::new(kdtree::KdTree::build(prims)),
             AccelKind::Grid => Box::new(grid::Grid::build(prims)),
+            AccelKind::Octree => Box::new(octree::Octree::build(prims)),
             AccelKind::List => Box::new(list::PrimitiveList::new(prims.len())),
         }
     }

@@ -1,0 +1,254 @@
+//! Octree (`--accel octree`).
+//!
+//! Build: adaptive subdivision of the scene box. A cell with more than `MAX_LEAF`
+//! primitives is cut at its centre into eight octants, each primitive going to every
+//! octant it overlaps (the exact triangle–box test, on padded boxes), until cells are
+//! small enough, the depth limit is reached, or a cut stops separating anything.
+//!
+//! Traversal (in the spirit of Revelles, Ureña & Lastra 2000): inside a cell the ray
+//! starts in the octant that holds its entry point and crosses the three mid-planes in
+//! the order of their distances, each crossing flipping one bit of the octant index — so
+//! the (at most four) octants it passes are visited in order along the ray, each with
+//! its own part of the ray's interval. The search ends when the closest hit lies before
+//! the next octant.
+
+use super::mailbox::Mailbox;
+use super::overlap::{cell_padding, overlaps, padded};
+use super::{search_limit, Accelerator};
+use crate::aabb::Aabb;
+use crate::hit::Hit;
+use crate::primitive::Primitive;
+use crate::ray::{PreparedRay, Ray};
+
+const MAX_LEAF: usize = 8;
+const MAX_DEPTH: usize = 16;
+/// Each level pushes at most three octants.
+const STACK_SIZE: usize = 3 * MAX_DEPTH + 4;
+const INTERIOR: u32 = u32::MAX;
+
+/// Interior: `first` = index of the first of eight consecutive children (octant `i` has
+/// bit 0 set for the upper half in x, bit 1 in y, bit 2 in z), `count` = `INTERIOR`.
+/// Leaf: `prim_ids[first..first + count]`.
+#[derive(Clone, Copy, Debug)]
+struct OctNode {
+    first: u32,
+    count: u32,
+}
+
+pub struct Octree {
+    bounds: Aabb,
+    nodes: Vec<OctNode>,
+    prim_ids: Vec<u32>,
+    prim_count: usize,
+}
+
+fn octant(b: &Aabb, i: usize) -> Aabb {
+    let mid = b.centroid();
+    let mut o = *b;
+    for a in 0..3 {
+        if i >> a & 1 == 1 {
+            o.min[a] = mid[a];
+        } else {
+            o.max[a] = mid[a];
+        }
+    }
+    o
+}
+
+struct Builder<'a> {
+    prims: &'a [Primitive],
+    boxes: Vec<Aabb>,
+    pad: f32,
+    nodes: Vec<OctNode>,
+    prim_ids: Vec<u32>,
+}
+
+impl Builder<'_> {
+    fn build(&mut self, me: usize, cell: &Aabb, items: Vec<u32>, depth: usize) {
+        let leaf = |b: &mut Self, items: &[u32]| {
+            b.nodes[me] = OctNode {
+                first: b.prim_ids.len() as u32,
+                count: items.len() as u32,
+            };
+            b.prim_ids.extend_from_slice(items);
+        };
+        if items.len() <= MAX_LEAF || depth >= MAX_DEPTH {
+            return leaf(self, &items);
+        }
+        let children: Vec<Vec<u32>> = (0..8)
+            .map(|i| {
+                let o = padded(&octant(cell, i), self.pad);
+                items
+                    .iter()
+                    .copied()
+                    .filter(|&p| {
+                        let b = &self.boxes[p as usize];
+                        b.min.cmple(o.max).all() && o.min.cmple(b.max).all() && overlaps(&self.prims[p as usize], &o)
+                    })
+                    .collect()
+            })
+            .collect();
+        if children.iter().all(|c| c.len() == items.len() || c.is_empty()) {
+            // Cutting separates nothing (every primitive spans the centre).
+            return leaf(self, &items);
+        }
+        let first = self.nodes.len();
+        self.nodes[me] = OctNode {
+            first: first as u32,
+            count: INTERIOR,
+        };
+        self.nodes.extend([OctNode { first: 0, count: 0 }; 8]);
+        for (i, c) in children.into_iter().enumerate() {
+            self.build(first + i, &octant(cell, i), c, depth + 1);
+        }
+    }
+}
+
+impl Octree {
+    pub fn build(prims: &[Primitive]) -> Octree {
+        let boxes: Vec<Aabb> = prims.iter().map(|p| p.bounds()).collect();
+        let scene = boxes.iter().fold(Aabb::EMPTY, |b, p| b.union(p));
+        if prims.is_empty() {
+            return Octree {
+                bounds: Aabb::EMPTY,
+                nodes: Vec::new(),
+                prim_ids: Vec::new(),
+                prim_count: 0,
+            };
+        }
+        let pad = cell_padding(&scene);
+        let bounds = padded(&scene, pad);
+        let mut b = Builder {
+            prims,
+            boxes,
+            pad,
+            nodes: vec![OctNode { first: 0, count: 0 }],
+            prim_ids: Vec::new(),
+        };
+        b.build(0, &bounds, (0..prims.len() as u32).collect(), 0);
+        Octree {
+            bounds,
+            nodes: b.nodes,
+            prim_ids: b.prim_ids,
+            prim_count: prims.len(),
+        }
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Visits the leaves the ray crosses, in order; `leaf` gets a leaf's primitives and
+    /// returns the distance beyond which nothing more can be found (`None`: stop).
+    #[inline(always)]
+    fn walk(&self, ray: &Ray, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let r = PreparedRay::new(*ray);
+        let Some((t0, t1)) = self.bounds.intersect(&r, search_limit(ray.t_max)) else {
+            return;
+        };
+        // (node, cell, entry, exit), nearest on top.
+        let mut stack = [(0u32, Aabb::EMPTY, 0.0f32, 0.0f32); STACK_SIZE];
+        stack[0] = (0, self.bounds, t0, t1);
+        let mut sp = 1;
+        let mut limit = f32::INFINITY;
+        while sp > 0 {
+            sp -= 1;
+            let (node, cell, t0, t1) = stack[sp];
+            if limit < t0 {
+                return;
+            }
+            let n = self.nodes[node as usize];
+            if n.count != INTERIOR {
+                let first = n.first as usize;
+                match leaf(&self.prim_ids[first..first + n.count as usize]) {
+                    Some(l) => limit = l,
+                    None => return,
+                }
+                continue;
+            }
+            let mid = cell.centroid();
+            let mut t_mid = [f32::INFINITY; 3];
+            let mut octant_index = 0usize;
+            for a in 0..3 {
+                let d = ray.dir[a];
+                let above = if d == 0.0 {
+                    ray.origin[a] >= mid[a]
+                } else {
+                    t_mid[a] = (mid[a] - ray.origin[a]) * r.inv_dir[a];
+                    // Moving up, the ray is in the upper half once past the plane.
+                    (d > 0.0) == (t0 >= t_mid[a])
+                };
+                octant_index |= (above as usize) << a;
+            }
+            // The mid-plane crossings inside (t0, t1), in order.
+            let mut crossings: [(f32, usize); 3] = [(0.0, 0); 3];
+            let mut k = 0;
+            for (a, &t) in t_mid.iter().enumerate() {
+                if t > t0 && t < t1 {
+                    crossings[k] = (t, a);
+                    k += 1;
+                }
+            }
+            crossings[..k].sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+            // Octants in ray order with their intervals; pushed farthest first.
+            let mut visits = [(0usize, 0.0f32, 0.0f32); 4];
+            let mut enter = t0;
+            for (j, &(t, a)) in crossings[..k].iter().enumerate() {
+                visits[j] = (octant_index, enter, t);
+                octant_index ^= 1 << a;
+                enter = t;
+            }
+            visits[k] = (octant_index, enter, t1);
+            for &(o, a, b) in visits[..=k].iter().rev() {
+                stack[sp] = (n.first + o as u32, octant(&cell, o), a, b);
+                sp += 1;
+            }
+        }
+    }
+}
+
+impl Accelerator for Octree {
+    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+        let r = PreparedRay::new(*ray);
+        let mut best: Option<Hit> = None;
+        let mut t_max = ray.t_max;
+        Mailbox::with(self.prim_count, |mailbox| {
+            self.walk(ray, |ids| {
+                for &pi in ids {
+                    if !mailbox.first_visit(pi) {
+                        continue;
+                    }
+                    if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
+                        if Hit::is_closer_than(t, pi, &best) {
+                            best = Some(Hit { t, prim: pi, b1, b2 });
+                            t_max = t;
+                        }
+                    }
+                }
+                Some(best.map_or(f32::INFINITY, |h| search_limit(h.t)))
+            })
+        });
+        best
+    }
+
+    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+        let r = PreparedRay::new(*ray);
+        let mut hit = false;
+        Mailbox::with(self.prim_count, |mailbox| {
+            self.walk(ray, |ids| {
+                hit = ids
+                    .iter()
+                    .any(|&pi| mailbox.first_visit(pi) && prims[pi as usize].intersect(&r, ray.t_max).is_some());
+                (!hit).then_some(f32::INFINITY)
+            })
+        });
+        hit
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<OctNode>() + self.prim_ids.len() * 4
+    }
+}
