@@ -28,8 +28,9 @@ const FAR_WIDENING: f32 = 1.0 + 2.0 * gamma(3);
 pub struct RayBoxes {
     origin: [f32; 3],
     inv_dir: [f32; 3],
-    /// Row of `WideNode::bounds` holding the plane the ray enters by (min or max).
+    /// Rows of `WideNode::bounds` holding the planes the ray enters and leaves by.
     near_row: [usize; 3],
+    far_row: [usize; 3],
     zero: [bool; 3],
     t_min: f32,
 }
@@ -41,6 +42,7 @@ impl RayBoxes {
             origin: r.ray.origin.to_array(),
             inv_dir: inv,
             near_row: [0, 1, 2].map(|a| if inv[a] >= 0.0 { a } else { a + 3 }),
+            far_row: [0, 1, 2].map(|a| if inv[a] >= 0.0 { a + 3 } else { a }),
             zero: [r.zero_axes.test(0), r.zero_axes.test(1), r.zero_axes.test(2)],
             t_min: r.ray.t_min,
         }
@@ -49,13 +51,21 @@ impl RayBoxes {
 
 /// Which child boxes a ray enters before `t_max`, and where.
 pub trait BoxTest {
+    /// The ray in the form the test wants it (SIMD broadcasts), made once per ray.
+    type Ray;
+    unsafe fn prepare(r: &RayBoxes) -> Self::Ray;
     /// `ZERO`: the ray has direction components that are zero.
-    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32;
+    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32;
 }
 
 pub struct Scalar;
 
 impl BoxTest for Scalar {
+    type Ray = RayBoxes;
+    #[inline(always)]
+    unsafe fn prepare(r: &RayBoxes) -> RayBoxes {
+        *r
+    }
     #[inline(always)]
     unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
         let mut mask = 0;
@@ -68,7 +78,7 @@ impl BoxTest for Scalar {
                     inside &= lo <= r.origin[a] && r.origin[a] <= hi;
                 } else {
                     let n = (node.bounds[r.near_row[a]][i] - r.origin[a]) * r.inv_dir[a];
-                    let f = (node.bounds[(r.near_row[a] + 3) % 6][i] - r.origin[a]) * r.inv_dir[a];
+                    let f = (node.bounds[r.far_row[a]][i] - r.origin[a]) * r.inv_dir[a];
                     near = if n > near { n } else { near };
                     far = if f < far { f } else { far };
                 }
@@ -95,23 +105,42 @@ mod x86 {
     pub struct Sse;
     pub struct Avx;
 
+    /// The ray as SIMD broadcasts (`N` is `__m128` or `__m256`).
+    #[derive(Clone, Copy)]
+    pub struct Broadcast<N> {
+        origin: [N; 3],
+        inv_dir: [N; 3],
+        t_min: N,
+        rb: RayBoxes,
+    }
+
     impl BoxTest for Sse {
+        type Ray = Broadcast<__m128>;
         #[inline(always)]
-        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        unsafe fn prepare(r: &RayBoxes) -> Self::Ray {
+            Broadcast {
+                origin: r.origin.map(|x| _mm_set1_ps(x)),
+                inv_dir: r.inv_dir.map(|x| _mm_set1_ps(x)),
+                t_min: _mm_set1_ps(r.t_min),
+                rb: *r,
+            }
+        }
+        #[inline(always)]
+        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
             let mut mask = 0;
+            let rb = &r.rb;
             for half in 0..2 {
-                let row = |k: usize| _mm_loadu_ps(node.bounds[k].as_ptr().add(4 * half));
-                let mut near = _mm_set1_ps(r.t_min);
+                let row = |k: usize| _mm_load_ps(node.bounds.get_unchecked(k).as_ptr().add(4 * half));
+                let mut near = r.t_min;
                 let mut far = _mm_set1_ps(f32::INFINITY);
                 let mut inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
                 for a in 0..3 {
-                    let o = _mm_set1_ps(r.origin[a]);
-                    if ZERO && r.zero[a] {
+                    let o = r.origin[a];
+                    if ZERO && rb.zero[a] {
                         inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmple_ps(row(a), o), _mm_cmple_ps(o, row(a + 3))));
                     } else {
-                        let inv = _mm_set1_ps(r.inv_dir[a]);
-                        let n = _mm_mul_ps(_mm_sub_ps(row(r.near_row[a]), o), inv);
-                        let f = _mm_mul_ps(_mm_sub_ps(row((r.near_row[a] + 3) % 6), o), inv);
+                        let n = _mm_mul_ps(_mm_sub_ps(row(rb.near_row[a]), o), r.inv_dir[a]);
+                        let f = _mm_mul_ps(_mm_sub_ps(row(rb.far_row[a]), o), r.inv_dir[a]);
                         near = _mm_max_ps(n, near);
                         far = _mm_min_ps(f, far);
                     }
@@ -126,15 +155,26 @@ mod x86 {
     }
 
     impl BoxTest for Avx {
+        type Ray = Broadcast<__m256>;
         #[inline(always)]
-        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            let row = |k: usize| _mm256_load_ps(node.bounds[k].as_ptr());
-            let mut near = _mm256_set1_ps(r.t_min);
+        unsafe fn prepare(r: &RayBoxes) -> Self::Ray {
+            Broadcast {
+                origin: r.origin.map(|x| _mm256_set1_ps(x)),
+                inv_dir: r.inv_dir.map(|x| _mm256_set1_ps(x)),
+                t_min: _mm256_set1_ps(r.t_min),
+                rb: *r,
+            }
+        }
+        #[inline(always)]
+        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            let rb = &r.rb;
+            let row = |k: usize| _mm256_load_ps(node.bounds.get_unchecked(k).as_ptr());
+            let mut near = r.t_min;
             let mut far = _mm256_set1_ps(f32::INFINITY);
             let mut inside = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
             for a in 0..3 {
-                let o = _mm256_set1_ps(r.origin[a]);
-                if ZERO && r.zero[a] {
+                let o = r.origin[a];
+                if ZERO && rb.zero[a] {
                     inside = _mm256_and_ps(
                         inside,
                         _mm256_and_ps(
@@ -143,9 +183,8 @@ mod x86 {
                         ),
                     );
                 } else {
-                    let inv = _mm256_set1_ps(r.inv_dir[a]);
-                    let n = _mm256_mul_ps(_mm256_sub_ps(row(r.near_row[a]), o), inv);
-                    let f = _mm256_mul_ps(_mm256_sub_ps(row((r.near_row[a] + 3) % 6), o), inv);
+                    let n = _mm256_mul_ps(_mm256_sub_ps(row(rb.near_row[a]), o), r.inv_dir[a]);
+                    let f = _mm256_mul_ps(_mm256_sub_ps(row(rb.far_row[a]), o), r.inv_dir[a]);
                     near = _mm256_max_ps(n, near);
                     far = _mm256_min_ps(f, far);
                 }
@@ -179,7 +218,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
     prims: &[Primitive],
     r: &PreparedRay,
 ) -> Option<Hit> {
-    let rb = RayBoxes::new(r);
+    let rb = T::prepare(&RayBoxes::new(r));
     let mut best = None;
     let mut t_max = r.ray.t_max;
     let mut stack = [const { MaybeUninit::<u64>::uninit() }; STACK_SIZE];
@@ -245,7 +284,7 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool>(
     prims: &[Primitive],
     r: &PreparedRay,
 ) -> bool {
-    let rb = RayBoxes::new(r);
+    let rb = T::prepare(&RayBoxes::new(r));
     let t_max = r.ray.t_max;
     let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK_SIZE];
     let mut sp = 0usize;
