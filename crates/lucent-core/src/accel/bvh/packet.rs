@@ -162,14 +162,17 @@ impl Packet {
             _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
             _mm_cmpeq_ps(w, zero),
         );
-        let neg = _mm_or_ps(
-            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
-            _mm_cmplt_ps(w, zero),
-        );
-        let pos = _mm_or_ps(
-            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
-            _mm_cmpgt_ps(w, zero),
-        );
+        let neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
+        let pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
+        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
+        // Lanes the scalar code takes: edge functions that rounded to zero, and
+        // non-triangles (flagged; their NaN corners never pass the tests below).
+        let scalar = _mm_movemask_ps(any_zero) as u32 | other;
+        // Most packets are missed by the edge tests alone: skip the distance then.
+        let inside = _mm_movemask_ps(_mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpord_ps(u, u))) as u32 & !scalar;
+        if inside == 0 {
+            return LaneHits::none(scalar);
+        }
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let t_scaled = _mm_add_ps(
             _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, az)), _mm_mul_ps(v, _mm_mul_ps(sz, bz))),
@@ -177,27 +180,16 @@ impl Packet {
         );
         let inv_det = _mm_div_ps(_mm_set1_ps(1.0), det);
         let t = _mm_mul_ps(t_scaled, inv_det);
-        let inside = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpneq_ps(det, zero));
-        let in_range = _mm_and_ps(
-            _mm_cmpgt_ps(t, _mm_set1_ps(r.ray.t_min)),
-            _mm_cmple_ps(t, _mm_set1_ps(t_max)),
+        let accept = _mm_and_ps(
+            _mm_cmpneq_ps(det, zero),
+            _mm_and_ps(
+                _mm_cmpgt_ps(t, _mm_set1_ps(r.ray.t_min)),
+                _mm_cmple_ps(t, _mm_set1_ps(t_max)),
+            ),
         );
-        let mut scalar = _mm_movemask_ps(any_zero) as u32;
-        let mut mask = _mm_movemask_ps(_mm_and_ps(inside, in_range)) as u32 & !scalar;
-        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
-        if other != 0 {
-            // Flagged lanes are non-triangles (their NaN corners never set `mask`).
-            scalar |= other;
-            mask &= !other;
-        }
-        let mut hits = LaneHits {
-            mask,
-            scalar,
-            t: [0.0; LANES],
-            v: [0.0; LANES],
-            w: [0.0; LANES],
-            inv_det: [0.0; LANES],
-        };
+        let mask = _mm_movemask_ps(accept) as u32 & inside;
+        let mut hits = LaneHits::none(scalar);
+        hits.mask = mask;
         if mask != 0 {
             _mm_storeu_ps(hits.t.as_mut_ptr(), t);
             _mm_storeu_ps(hits.v.as_mut_ptr(), v);
@@ -217,14 +209,7 @@ impl Packet {
             }
         }
         let _ = (r, t_max);
-        LaneHits {
-            mask: 0,
-            scalar,
-            t: [0.0; LANES],
-            v: [0.0; LANES],
-            w: [0.0; LANES],
-            inv_det: [0.0; LANES],
-        }
+        LaneHits::none(scalar)
     }
 }
 
@@ -237,6 +222,20 @@ struct LaneHits {
     v: [f32; LANES],
     w: [f32; LANES],
     inv_det: [f32; LANES],
+}
+
+impl LaneHits {
+    #[inline(always)]
+    fn none(scalar: u32) -> LaneHits {
+        LaneHits {
+            mask: 0,
+            scalar,
+            t: [0.0; LANES],
+            v: [0.0; LANES],
+            w: [0.0; LANES],
+            inv_det: [0.0; LANES],
+        }
+    }
 }
 
 /// The set bits of a mask, lowest first.
