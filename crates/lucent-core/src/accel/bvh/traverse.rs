@@ -233,27 +233,39 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
                 if rest == 0 {
-                    cur = node.child[first];
+                    cur = *node.child.get_unchecked(first);
+                    continue;
+                }
+                if rest & (rest - 1) == 0 {
+                    // Two children, the common case: no sorting loop.
+                    let second = rest.trailing_zeros() as usize;
+                    let (d0, d1) = (*dist.get_unchecked(first), *dist.get_unchecked(second));
+                    let (near, far) = if d0 <= d1 { (first, second) } else { (second, first) };
+                    let far_entry = entry(*dist.get_unchecked(far), *node.child.get_unchecked(far));
+                    stack.get_unchecked_mut(sp).write(far_entry);
+                    sp += 1;
+                    cur = *node.child.get_unchecked(near);
                     continue;
                 }
                 // Sort the entered children by distance: push all, then order the new
                 // entries so that the nearest ends on top.
                 let base = sp;
                 for i in super::packet::Lanes(mask) {
-                    stack.get_unchecked_mut(sp).write(entry(dist[i], node.child[i]));
+                    let e = entry(*dist.get_unchecked(i), *node.child.get_unchecked(i));
+                    stack.get_unchecked_mut(sp).write(e);
                     sp += 1;
                 }
                 for i in base + 1..sp {
-                    let e = stack[i].assume_init();
+                    let e = stack.get_unchecked(i).assume_init();
                     let mut j = i;
-                    while j > base && stack[j - 1].assume_init() < e {
-                        stack[j] = stack[j - 1];
+                    while j > base && stack.get_unchecked(j - 1).assume_init() < e {
+                        *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
                         j -= 1;
                     }
-                    stack[j].write(e);
+                    stack.get_unchecked_mut(j).write(e);
                 }
                 sp -= 1;
-                cur = stack[sp].assume_init() as u32;
+                cur = stack.get_unchecked(sp).assume_init() as u32;
                 continue;
             }
         } else {
