@@ -84,12 +84,12 @@ fn leaf_slot(tree: &BinaryTree, leaf: &BinaryNode, prims: &[Primitive], out: &mu
         unreachable!("a leaf")
     };
     let first = out.packets.len() as u32;
-    let ids: Vec<u32> = tree.refs[start as usize..(start + count) as usize]
-        .iter()
-        .map(|r| r.prim)
-        .collect();
-    for chunk in ids.chunks(LANES) {
-        out.packets.push(Packet::new(prims, chunk));
+    for chunk in tree.refs[start as usize..(start + count) as usize].chunks(LANES) {
+        let mut ids = [0u32; LANES];
+        for (id, r) in ids.iter_mut().zip(chunk) {
+            *id = r.prim;
+        }
+        out.packets.push(Packet::new(prims, &ids[..chunk.len()]));
     }
     let n = out.packets.len() as u32 - first;
     assert!(
