@@ -197,6 +197,13 @@ mod x86 {
     }
 }
 
+/// The node at byte offset `offset` (see [`super::wide::LEAF`]).
+#[inline(always)]
+unsafe fn node_at(nodes: &[WideNode], offset: u32) -> &WideNode {
+    debug_assert!((offset as usize) < std::mem::size_of_val(nodes));
+    &*nodes.as_ptr().cast::<u8>().add(offset as usize).cast::<WideNode>()
+}
+
 #[inline(always)]
 fn leaf_packets(reference: u32) -> std::ops::Range<usize> {
     let first = (reference & FIRST_MASK) as usize;
@@ -227,7 +234,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
     let mut cur = 0u32;
     loop {
         if cur & LEAF == 0 {
-            let node = nodes.get_unchecked(cur as usize);
+            let node = node_at(nodes, cur);
             let mask = T::test::<ZERO>(node, &rb, search_limit(t_max), &mut dist);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
@@ -304,7 +311,7 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool>(
     let mut cur = 0u32;
     loop {
         if cur & LEAF == 0 {
-            let node = nodes.get_unchecked(cur as usize);
+            let node = node_at(nodes, cur);
             let mut mask = T::test::<ZERO>(node, &rb, search_limit(t_max), &mut dist);
             if mask != 0 {
                 cur = node.child[mask.trailing_zeros() as usize];

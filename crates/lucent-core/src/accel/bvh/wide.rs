@@ -11,7 +11,8 @@ use super::packet::{Packet, LANES};
 use crate::primitive::Primitive;
 
 pub const WIDTH: usize = 8;
-/// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`.
+/// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`;
+/// an interior child is the byte offset of its node in the node array.
 pub const LEAF: u32 = 1 << 31;
 pub const PACKET_SHIFT: u32 = 28;
 pub const FIRST_MASK: u32 = (1 << PACKET_SHIFT) - 1;
@@ -129,7 +130,16 @@ fn collapse_node(tree: &BinaryTree, b: u32, prims: &[Primitive], out: &mut WideT
         let child = &tree.nodes[c as usize];
         let reference = match child.kind {
             Kind::Leaf { .. } => leaf_slot(tree, child, prims, out),
-            Kind::Interior { .. } => collapse_node(tree, c, prims, out),
+            Kind::Interior { .. } => {
+                // Interior children are referenced by byte offset: traversal then needs
+                // no multiplication between loading a reference and loading the node.
+                let offset = collapse_node(tree, c, prims, out) as usize * std::mem::size_of::<WideNode>();
+                assert!(
+                    offset < LEAF as usize,
+                    "too many nodes for the BVH's 31-bit node offsets"
+                );
+                offset as u32
+            }
         };
         set_child(&mut out.nodes[me], slot, child, reference);
     }
