@@ -186,6 +186,9 @@ fn same_bytes_for_any_thread_count_and_structure() {
         ("t1", vec!["--threads", "1"]),
         ("t2", vec!["--threads", "2"]),
         ("list", vec!["--accel", "list"]),
+        ("kdtree", vec!["--accel", "kdtree"]),
+        ("grid", vec!["--accel", "grid"]),
+        ("octree", vec!["--accel", "octree"]),
     ] {
         let out = format!("{name}.png");
         let mut a = vec!["render", "s.test", "-q", "-o", &out];
@@ -193,8 +196,9 @@ fn same_bytes_for_any_thread_count_and_structure() {
         assert!(lucent(&dir, &a).status.success());
     }
     let t1 = fs::read(dir.join("t1.png")).unwrap();
-    assert_eq!(t1, fs::read(dir.join("t2.png")).unwrap());
-    assert_eq!(t1, fs::read(dir.join("list.png")).unwrap());
+    for other in ["t2", "list", "kdtree", "grid", "octree"] {
+        assert_eq!(t1, fs::read(dir.join(format!("{other}.png"))).unwrap(), "{other}");
+    }
 }
 
 #[test]
@@ -221,4 +225,122 @@ fn diff_compares_images() {
     let o = lucent(&dir, &["diff", "a.png", "a.png", "--max-pixels", "0"]);
     assert!(o.status.success());
     assert!(String::from_utf8_lossy(&o.stdout).starts_with("pixels_over=0 pixels=768 "));
+}
+
+/// Eight little-endian f32 per ray: origin, t_near, direction, t_far.
+fn ray_records(rays: &[[f32; 8]]) -> Vec<u8> {
+    rays.iter().flatten().flat_map(|f| f.to_le_bytes()).collect()
+}
+
+#[test]
+fn bench_rays_traces_a_ray_file_and_writes_the_answers() {
+    let dir = workdir("bench-rays");
+    // A unit quad in z = 0 (two triangles, fan order) and a triangle behind it at z = -1.
+    fs::write(
+        dir.join("m.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 -1\nv 3 0 -1\nv 0 3 -1\nf 1 2 3 4\nf 5 6 7\n",
+    )
+    .unwrap();
+    let inf = f32::INFINITY;
+    let rays = [
+        [0.75, 0.25, 1.0, 0.0, 0.0, 0.0, -1.0, inf], // first triangle of the quad, t = 1
+        [0.25, 0.75, 1.0, 0.0, 0.0, 0.0, -1.0, inf], // second triangle, t = 1
+        [2.0, 0.5, 1.0, 0.0, 0.0, 0.0, -1.0, inf],   // misses the quad, hits the back one at t = 2
+        [5.0, 5.0, 1.0, 0.0, 0.0, 0.0, -1.0, inf],   // misses everything
+        [2.0, 0.5, 1.0, 0.0, 0.0, 0.0, -1.0, 1.5],   // stops short of the back triangle
+    ];
+    fs::write(dir.join("r.bin"), ray_records(&rays)).unwrap();
+    let answers = |bytes: Vec<u8>| -> Vec<(f32, u32)> {
+        bytes
+            .chunks_exact(8)
+            .map(|c| {
+                (
+                    f32::from_le_bytes(c[..4].try_into().unwrap()),
+                    u32::from_le_bytes(c[4..].try_into().unwrap()),
+                )
+            })
+            .collect()
+    };
+    for accel in ["bvh", "kdtree", "grid", "octree", "list"] {
+        let o = lucent(
+            &dir,
+            &[
+                "bench",
+                "rays",
+                "m.obj",
+                "r.bin",
+                "--accel",
+                accel,
+                "--reps",
+                "2",
+                "--threads",
+                "1",
+                "--hits",
+                "h.bin",
+            ],
+        );
+        assert!(o.status.success(), "{accel}: {}", stderr(&o));
+        let line = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(line.starts_with("mrays_per_s=") && line.contains(" build_s=") && line.contains(" bytes_per_tri="));
+        assert!(line.contains(" rays=5 hits=3 "), "{line}");
+        let miss = (inf, u32::MAX);
+        assert_eq!(
+            answers(fs::read(dir.join("h.bin")).unwrap()),
+            [(1.0, 0), (1.0, 1), (2.0, 2), miss, miss]
+        );
+
+        let o = lucent(
+            &dir,
+            &[
+                "bench",
+                "rays",
+                "m.obj",
+                "r.bin",
+                "--accel",
+                accel,
+                "--occluded",
+                "--reps",
+                "1",
+                "--hits",
+                "o.bin",
+            ],
+        );
+        assert!(o.status.success(), "{accel}: {}", stderr(&o));
+        let free = (inf, 0);
+        assert_eq!(
+            answers(fs::read(dir.join("o.bin")).unwrap()),
+            [(0.0, 0), (0.0, 0), (0.0, 0), free, free]
+        );
+    }
+}
+
+#[test]
+fn bench_rays_rejects_bad_files_without_writing() {
+    let dir = workdir("bench-bad");
+    fs::write(dir.join("m.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    fs::write(dir.join("short.bin"), [0u8; 33]).unwrap();
+    fs::write(
+        dir.join("nan.bin"),
+        ray_records(&[[f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0]]),
+    )
+    .unwrap();
+    fs::write(
+        dir.join("ok.bin"),
+        ray_records(&[[0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0, 9.0]]),
+    )
+    .unwrap();
+    for (args, message) in [
+        (vec!["m.obj", "short.bin"], "not a whole number of 32-byte ray records"),
+        (vec!["m.obj", "nan.bin"], "ray 0 has a NaN"),
+        (vec!["m.obj", "missing.bin"], "cannot read ray file"),
+        (vec!["missing.obj", "ok.bin"], "cannot read OBJ mesh"),
+    ] {
+        let mut a = vec!["bench", "rays"];
+        a.extend(args);
+        a.extend(["--hits", "h.bin"]);
+        let o = lucent(&dir, &a);
+        assert_eq!(o.status.code(), Some(2), "{a:?}");
+        assert!(stderr(&o).contains(message), "{a:?}: {}", stderr(&o));
+        assert!(!dir.join("h.bin").exists());
+    }
 }
