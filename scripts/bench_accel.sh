@@ -25,6 +25,7 @@ fi
 meshes=("$@"); [ ${#meshes[@]} -gt 0 ] || meshes=("$bench/dragon_100k.obj" "$bench/dragon_1m6.obj.gz")
 export REPS=${REPS:-5}
 export WORK=${WORK:-$(mktemp -d)}
+mkdir -p "$WORK"
 (cd "$root" && cargo build --release --quiet)
 bin=$root/target/release/lucent
 

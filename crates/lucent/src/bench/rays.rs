@@ -166,7 +166,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         write_file_atomically(out, &bytes).map_err(|e| e.to_string())?;
     }
     println!(
-        "mrays_per_s={:.3} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} tris={} trace_s={trace_s:.4}",
+        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
         accel.memory_bytes() as f64 / prims.len().max(1) as f64,
         rays.len(),
