@@ -8,7 +8,7 @@
 #    side on the same files (primary, diffuse and shadow rays written by the Embree harness),
 #    one thread, and prints the ratios and how many answers differ from Embree's.
 # 2. On the same ray files, one thread: every other structure (kdtree, grid, octree; list on
-#    the first 2,000 rays of each set only: brute force on the whole set takes hours), and
+#    2,000 rays spread over each set only: brute force on the whole set takes hours), and
 #    the BVH with two threads. Prints one line per run (build_s, bytes_per_tri, Mrays/s).
 #
 # Needs g++ and Debian's libembree-dev (installed here with apt-get when missing and root).
@@ -39,7 +39,9 @@ for mesh in "${meshes[@]}"; do
     for set in primary diffuse shadow; do
         occ=(); [ $set = shadow ] && occ=(--occluded)
         rays=$WORK/$name/$set.rays
-        head -c $((2000 * 32)) "$rays" > "$WORK/$name/$set.2000.rays"
+        # 2,000 rays spread evenly over the set (the first ones would all be sky).
+        python3 -c "import numpy as np, sys; r = np.fromfile(sys.argv[1], '<f4').reshape(-1, 8); r[::max(1, len(r) // 2000)][:2000].tofile(sys.argv[2])" \
+            "$rays" "$WORK/$name/$set.2000.rays"
         for accel in bvh kdtree grid octree list; do
             r=$rays; reps=$REPS
             if [ $accel = list ]; then r=$WORK/$name/$set.2000.rays; reps=1; fi
