@@ -66,25 +66,30 @@ pub struct PreparedRay {
 impl PreparedRay {
     pub fn new(ray: Ray) -> PreparedRay {
         let d = ray.dir;
-        let inv = |c: f32| {
-            let r = 1.0 / c;
-            if r.is_finite() {
-                r
-            } else if c == 0.0 {
-                f32::MAX
-            } else {
-                f32::MAX.copysign(c)
-            }
-        };
-        let inv_dir = Vec3A::new(inv(d.x), inv(d.y), inv(d.z));
+        // One vector division; the rare zero or subnormal components are fixed after.
+        let mut inv_dir = Vec3A::ONE / d;
+        if !inv_dir.is_finite() {
+            let fix = |c: f32, r: f32| {
+                if r.is_finite() {
+                    r
+                } else if c == 0.0 {
+                    f32::MAX
+                } else {
+                    f32::MAX.copysign(c)
+                }
+            };
+            inv_dir = Vec3A::new(fix(d.x, inv_dir.x), fix(d.y, inv_dir.y), fix(d.z, inv_dir.z));
+        }
         let kz = max_abs_axis(d);
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
-        let dz = d[kz];
         // Keep the winding of the projected triangle: swap when looking down -z.
-        if dz < 0.0 {
+        if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        // `1/d[kz]` is `inv_dir[kz]`: the dominant component of a non-zero direction is
+        // not zero, so its reciprocal was not replaced.
+        let sz = inv_dir[kz];
         PreparedRay {
             ray,
             inv_dir,
@@ -92,9 +97,9 @@ impl PreparedRay {
             kx,
             ky,
             kz,
-            sx: d[kx] / dz,
-            sy: d[ky] / dz,
-            sz: 1.0 / dz,
+            sx: d[kx] * sz,
+            sy: d[ky] * sz,
+            sz,
         }
     }
 }
