@@ -314,10 +314,10 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool>(
             let node = node_at(nodes, cur);
             let mut mask = T::test::<ZERO>(node, &rb, search_limit(t_max), &mut dist);
             if mask != 0 {
-                cur = node.child[mask.trailing_zeros() as usize];
+                cur = *node.child.get_unchecked(mask.trailing_zeros() as usize);
                 mask &= mask - 1;
                 for i in super::packet::Lanes(mask) {
-                    stack.get_unchecked_mut(sp).write(node.child[i]);
+                    stack.get_unchecked_mut(sp).write(*node.child.get_unchecked(i));
                     sp += 1;
                 }
                 continue;
