@@ -57,6 +57,9 @@ pub struct PreparedRay {
     pub kx: usize,
     pub ky: usize,
     pub kz: usize,
+    /// The origin's components along `kx`, `ky`, `kz` (picked once per ray, not once
+    /// per triangle: choosing by a per-ray axis is a branch or a round trip through memory).
+    pub origin_k: [f32; 3],
     /// Shear constants that map the ray to +z.
     pub sx: f32,
     pub sy: f32,
@@ -97,6 +100,7 @@ impl PreparedRay {
             kx,
             ky,
             kz,
+            origin_k: [ray.origin[kx], ray.origin[ky], ray.origin[kz]],
             sx: d[kx] * sz,
             sy: d[ky] * sz,
             sz,
