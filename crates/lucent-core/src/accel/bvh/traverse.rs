@@ -197,6 +197,26 @@ mod x86 {
     }
 }
 
+/// Asks for the first cache lines of a child that was pushed on the stack: by the time
+/// it is popped, after the nearer subtree, they have arrived.
+#[inline(always)]
+unsafe fn prefetch(nodes: &[WideNode], packets: &[Packet], reference: u32) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let p = if reference & LEAF == 0 {
+            nodes.as_ptr().cast::<i8>().add(reference as usize)
+        } else {
+            packets.as_ptr().add(leaf_packets(reference).start).cast::<i8>()
+        };
+        for line in 0..4 {
+            _mm_prefetch::<_MM_HINT_T0>(p.add(64 * line));
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (nodes, packets, reference);
+}
+
 /// The node at byte offset `offset` (see [`super::wide::LEAF`]).
 #[inline(always)]
 unsafe fn node_at(nodes: &[WideNode], offset: u32) -> &WideNode {
@@ -248,6 +268,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
                     let second = rest.trailing_zeros() as usize;
                     let (d0, d1) = (*dist.get_unchecked(first), *dist.get_unchecked(second));
                     let (near, far) = if d0 <= d1 { (first, second) } else { (second, first) };
+                    prefetch(nodes, packets, *node.child.get_unchecked(far));
                     let far_entry = entry(*dist.get_unchecked(far), *node.child.get_unchecked(far));
                     stack.get_unchecked_mut(sp).write(far_entry);
                     sp += 1;
@@ -258,6 +279,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
                 // entries so that the nearest ends on top.
                 let base = sp;
                 for i in super::packet::Lanes(mask) {
+                    prefetch(nodes, packets, *node.child.get_unchecked(i));
                     let e = entry(*dist.get_unchecked(i), *node.child.get_unchecked(i));
                     stack.get_unchecked_mut(sp).write(e);
                     sp += 1;
@@ -317,6 +339,7 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool>(
                 cur = *node.child.get_unchecked(mask.trailing_zeros() as usize);
                 mask &= mask - 1;
                 for i in super::packet::Lanes(mask) {
+                    prefetch(nodes, packets, *node.child.get_unchecked(i));
                     stack.get_unchecked_mut(sp).write(*node.child.get_unchecked(i));
                     sp += 1;
                 }
