@@ -2,6 +2,12 @@
 //! and is tested against analytic answers; [`crate::primitive`] wraps them as the
 //! primitives a scene holds.
 
+pub mod cone;
+pub mod cuboid;
+pub mod cylinder;
+pub mod disk;
 pub mod plane;
+pub mod quadratic;
+pub mod quadric;
 pub mod sphere;
 pub mod triangle;
