@@ -5,7 +5,7 @@ use crate::aabb::Aabb;
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Affine3A, Mat3A, Vec3A};
 use crate::ray::PreparedRay;
-use crate::shape::{sphere, triangle};
+use crate::shape::{cone, cuboid, cylinder, disk, plane, quadric, sphere, triangle};
 
 /// A sphere or ellipsoid: the unit sphere mapped by an affine object-to-world transform.
 #[derive(Clone, Copy, Debug)]
@@ -34,7 +34,117 @@ impl Sphere {
     }
 }
 
+/// A shape of the geometry extensions in its object space (see `crate::shape`).
 #[derive(Clone, Copy, Debug)]
+pub enum AnalyticKind {
+    /// The plane through `point` with normal `normal`: unbounded, so it is kept out of
+    /// the acceleration structures and tested on its own.
+    Plane {
+        point: Vec3A,
+        normal: Vec3A,
+    },
+    Cuboid(Aabb),
+    Cylinder {
+        radius: f32,
+        zmin: f32,
+        zmax: f32,
+    },
+    Disk {
+        radius: f32,
+    },
+    Cone {
+        radius: f32,
+        height: f32,
+    },
+    Quadric {
+        coefficients: quadric::Coefficients,
+        clip: Aabb,
+    },
+}
+
+impl AnalyticKind {
+    /// Bounds in object space; `None` for the unbounded plane.
+    fn object_bounds(&self) -> Option<Aabb> {
+        let z = |lo: f32, hi: f32, r: f32| Aabb::new(Vec3A::new(-r, -r, lo), Vec3A::new(r, r, hi));
+        match *self {
+            AnalyticKind::Plane { .. } => None,
+            AnalyticKind::Cuboid(b) => Some(b),
+            AnalyticKind::Cylinder { radius, zmin, zmax } => Some(z(zmin, zmax, radius)),
+            AnalyticKind::Disk { radius } => Some(z(0.0, 0.0, radius)),
+            AnalyticKind::Cone { radius, height } => Some(z(0.0, height, radius)),
+            AnalyticKind::Quadric { clip, .. } => Some(clip),
+        }
+    }
+
+    fn intersect(&self, o: Vec3A, d: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
+        match self {
+            AnalyticKind::Plane { point, normal } => plane::intersect_plane(o, d, *point, *normal, t_min, t_max),
+            AnalyticKind::Cuboid(b) => cuboid::intersect(b, o, d, t_min, t_max),
+            AnalyticKind::Cylinder { radius, zmin, zmax } => {
+                cylinder::intersect(*radius, *zmin, *zmax, o, d, t_min, t_max)
+            }
+            AnalyticKind::Disk { radius } => disk::intersect(*radius, o, d, t_min, t_max),
+            AnalyticKind::Cone { radius, height } => cone::intersect(*radius, *height, o, d, t_min, t_max),
+            AnalyticKind::Quadric { coefficients, clip } => quadric::intersect(coefficients, clip, o, d, t_min, t_max),
+        }
+    }
+
+    /// Object-space normal (not normalised) at a surface point.
+    fn normal(&self, p: Vec3A) -> Vec3A {
+        match self {
+            AnalyticKind::Plane { normal, .. } => *normal,
+            AnalyticKind::Cuboid(b) => cuboid::normal(b, p),
+            AnalyticKind::Cylinder { .. } => cylinder::normal(p),
+            AnalyticKind::Disk { .. } => Vec3A::Z,
+            AnalyticKind::Cone { radius, height } => cone::normal(*radius, *height, p),
+            AnalyticKind::Quadric { coefficients, .. } => quadric::normal(coefficients, p),
+        }
+    }
+}
+
+/// An analytic shape placed by an affine object-to-world transform. Rays go into object
+/// space unnormalised, so `t` is the same in both spaces; normals come back by the
+/// inverse transpose.
+#[derive(Clone, Copy, Debug)]
+pub struct Analytic {
+    pub world_to_object: Affine3A,
+    pub normal_to_world: Mat3A,
+    /// World bounds; infinite for the plane.
+    pub bounds: Aabb,
+    pub kind: AnalyticKind,
+}
+
+impl Analytic {
+    pub fn new(object_to_world: Affine3A, kind: AnalyticKind) -> Analytic {
+        let world_to_object = object_to_world.inverse();
+        let bounds = match kind.object_bounds() {
+            Some(b) => Aabb::from_points(
+                &(0..8)
+                    .map(|i| {
+                        let corner = Vec3A::new(
+                            if i & 1 == 0 { b.min.x } else { b.max.x },
+                            if i & 2 == 0 { b.min.y } else { b.max.y },
+                            if i & 4 == 0 { b.min.z } else { b.max.z },
+                        );
+                        object_to_world.transform_point3a(corner)
+                    })
+                    .collect::<Vec<_>>(),
+            ),
+            None => Aabb {
+                min: Vec3A::NEG_INFINITY,
+                max: Vec3A::INFINITY,
+            },
+        };
+        Analytic {
+            world_to_object,
+            normal_to_world: world_to_object.matrix3.transpose(),
+            bounds,
+            kind,
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
 pub enum Shape {
     /// World-space vertices; `normals` indexes the scene's per-vertex normals
     /// (`trinormal`), `None` for the flat geometric normal (`tri`).
@@ -43,9 +153,11 @@ pub enum Shape {
         normals: Option<u32>,
     },
     Sphere(Sphere),
+    /// Boxed: it is much larger than a triangle, and meshes should not pay for it.
+    Analytic(Box<Analytic>),
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Primitive {
     pub shape: Shape,
     pub material: u32,
@@ -56,6 +168,7 @@ impl Primitive {
         match &self.shape {
             Shape::Triangle { p, .. } => Aabb::from_points(p),
             Shape::Sphere(s) => s.bounds,
+            Shape::Analytic(a) => a.bounds,
         }
     }
 
@@ -69,6 +182,11 @@ impl Primitive {
                 let o = s.world_to_object.transform_point3a(ray.ray.origin);
                 let d = s.world_to_object.transform_vector3a(ray.ray.dir);
                 sphere::intersect_unit_geometric(o, d, ray.ray.t_min, t_max).map(|t| (t, 0.0, 0.0))
+            }
+            Shape::Analytic(a) => {
+                let o = a.world_to_object.transform_point3a(ray.ray.origin);
+                let d = a.world_to_object.transform_vector3a(ray.ray.dir);
+                a.kind.intersect(o, d, ray.ray.t_min, t_max).map(|t| (t, 0.0, 0.0))
             }
         }
     }
@@ -88,6 +206,11 @@ impl Primitive {
                 let o = s.world_to_object.transform_point3a(origin);
                 let d = s.world_to_object.transform_vector3a(dir);
                 (s.normal_to_world * (o + d * hit.t)).normalize()
+            }
+            Shape::Analytic(a) => {
+                let o = a.world_to_object.transform_point3a(origin);
+                let d = a.world_to_object.transform_vector3a(dir);
+                (a.normal_to_world * a.kind.normal(o + d * hit.t)).normalize()
             }
         };
         SurfacePoint {

@@ -36,8 +36,9 @@ pub struct Grid {
 
 impl Grid {
     pub fn build(prims: &[Primitive]) -> Grid {
-        let scene = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()));
-        if prims.is_empty() {
+        let items: Vec<(u32, Aabb)> = super::bounded(prims).collect();
+        let scene = items.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b));
+        if items.is_empty() {
             return Grid {
                 bounds: Aabb::EMPTY,
                 res: [1; 3],
@@ -52,7 +53,7 @@ impl Grid {
         let ext = bounds.extent();
         // Flat scenes have no volume: give thin axes a token thickness for the estimate.
         let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3));
-        let per_unit = (DENSITY * prims.len() as f32 / (e.x * e.y * e.z)).cbrt();
+        let per_unit = (DENSITY * items.len() as f32 / (e.x * e.y * e.z)).cbrt();
         let res = [0, 1, 2].map(|a| ((ext[a] * per_unit).round() as usize).clamp(1, MAX_RES));
         let cell_size = ext / Vec3A::new(res[0] as f32, res[1] as f32, res[2] as f32);
         let mut grid = Grid {
@@ -66,7 +67,7 @@ impl Grid {
         // Two passes: count the entries of every cell, then fill them in.
         let cells = res[0] * res[1] * res[2];
         let mut count = vec![0u32; cells + 1];
-        grid.for_each_entry(prims, pad, |c, _| count[c] += 1);
+        grid.for_each_entry(prims, &items, pad, |c, _| count[c] += 1);
         let mut start = 0u32;
         for c in count.iter_mut() {
             let n = *c;
@@ -75,7 +76,7 @@ impl Grid {
         }
         let mut fill = count.clone();
         let mut ids = vec![0u32; start as usize];
-        grid.for_each_entry(prims, pad, |c, p| {
+        grid.for_each_entry(prims, &items, pad, |c, p| {
             ids[fill[c] as usize] = p;
             fill[c] += 1;
         });
@@ -102,9 +103,10 @@ impl Grid {
     }
 
     /// Calls `f(cell, prim)` for every cell every primitive overlaps.
-    fn for_each_entry(&self, prims: &[Primitive], pad: f32, mut f: impl FnMut(usize, u32)) {
-        for (i, prim) in prims.iter().enumerate() {
-            let b = padded(&prim.bounds(), pad);
+    fn for_each_entry(&self, prims: &[Primitive], items: &[(u32, Aabb)], pad: f32, mut f: impl FnMut(usize, u32)) {
+        for &(i, bounds) in items {
+            let prim = &prims[i as usize];
+            let b = padded(&bounds, pad);
             let lo = [0, 1, 2].map(|a| self.cell_of(b.min, a));
             let hi = [0, 1, 2].map(|a| self.cell_of(b.max, a));
             let single = lo == hi;
@@ -113,7 +115,7 @@ impl Grid {
                     for x in lo[0]..=hi[0] {
                         let c = [x, y, z];
                         if single || overlaps(prim, &padded(&self.cell_box(c), pad)) {
-                            f(self.index(c), i as u32);
+                            f(self.index(c), i);
                         }
                     }
                 }

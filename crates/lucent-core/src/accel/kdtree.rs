@@ -59,23 +59,17 @@ struct Builder<'a> {
 
 impl KdTree {
     pub fn build(prims: &[Primitive]) -> KdTree {
-        let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()));
+        let items: Vec<Item> = super::bounded(prims).map(|(prim, b)| Item { prim, b }).collect();
+        let bounds = items.iter().fold(Aabb::EMPTY, |acc, it| acc.union(&it.b));
+        let count = items.len();
         let mut builder = Builder {
             prims,
             pad: cell_padding(&bounds),
-            max_depth: (8.0 + 1.3 * (prims.len().max(1) as f32).log2()).round() as usize,
+            max_depth: (8.0 + 1.3 * (count.max(1) as f32).log2()).round() as usize,
             nodes: Vec::new(),
             prim_ids: Vec::new(),
         };
-        if !prims.is_empty() {
-            let items = prims
-                .iter()
-                .enumerate()
-                .map(|(i, p)| Item {
-                    prim: i as u32,
-                    b: p.bounds(),
-                })
-                .collect();
+        if count > 0 {
             builder.build_node(bounds, items, 0);
         }
         KdTree {

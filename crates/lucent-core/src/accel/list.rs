@@ -7,30 +7,27 @@ use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 
 pub struct PrimitiveList {
-    len: usize,
+    /// The bounded primitives, in scene order.
+    indices: Vec<u32>,
 }
 
 impl PrimitiveList {
-    pub fn new(len: usize) -> PrimitiveList {
-        PrimitiveList { len }
+    pub fn new(prims: &[Primitive]) -> PrimitiveList {
+        PrimitiveList {
+            indices: super::bounded(prims).map(|(i, _)| i).collect(),
+        }
     }
 }
 
 impl Accelerator for PrimitiveList {
     fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
-        debug_assert_eq!(prims.len(), self.len);
         let r = PreparedRay::new(*ray);
         let mut best: Option<Hit> = None;
-        for (i, p) in prims.iter().enumerate() {
+        for &i in &self.indices {
             let t_max = best.map_or(ray.t_max, |b| b.t);
-            if let Some((t, b1, b2)) = p.intersect(&r, t_max) {
-                if Hit::is_closer_than(t, i as u32, &best) {
-                    best = Some(Hit {
-                        t,
-                        prim: i as u32,
-                        b1,
-                        b2,
-                    });
+            if let Some((t, b1, b2)) = prims[i as usize].intersect(&r, t_max) {
+                if Hit::is_closer_than(t, i, &best) {
+                    best = Some(Hit { t, prim: i, b1, b2 });
                 }
             }
         }
@@ -39,10 +36,12 @@ impl Accelerator for PrimitiveList {
 
     fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
         let r = PreparedRay::new(*ray);
-        prims.iter().any(|p| p.intersect(&r, ray.t_max).is_some())
+        self.indices
+            .iter()
+            .any(|&i| prims[i as usize].intersect(&r, ray.t_max).is_some())
     }
 
     fn memory_bytes(&self) -> usize {
-        0
+        self.indices.len() * 4
     }
 }

@@ -16,6 +16,7 @@ pub mod overlap;
 #[cfg(test)]
 mod tests;
 
+use crate::aabb::Aabb;
 use crate::hit::Hit;
 use crate::primitive::Primitive;
 use crate::ray::Ray;
@@ -31,6 +32,16 @@ use crate::ray::Ray;
 #[inline(always)]
 pub fn search_limit(t: f32) -> f32 {
     t * (1.0 + 1.0 / 4096.0)
+}
+
+/// The primitives a structure holds: every one with finite bounds, as `(scene index,
+/// bounds)`. Unbounded ones (planes) are tested by the scene itself, outside any
+/// structure ([`crate::scene::Scene`]).
+pub fn bounded(prims: &[Primitive]) -> impl Iterator<Item = (u32, Aabb)> + '_ {
+    prims.iter().enumerate().filter_map(|(i, p)| {
+        let b = p.bounds();
+        (b.min.is_finite() && b.max.is_finite()).then_some((i as u32, b))
+    })
 }
 
 pub trait Accelerator: Send + Sync {
@@ -76,7 +87,7 @@ impl AccelKind {
             AccelKind::KdTree => Box::new(kdtree::KdTree::build(prims)),
             AccelKind::Grid => Box::new(grid::Grid::build(prims)),
             AccelKind::Octree => Box::new(octree::Octree::build(prims)),
-            AccelKind::List => Box::new(list::PrimitiveList::new(prims.len())),
+            AccelKind::List => Box::new(list::PrimitiveList::new(prims)),
         }
     }
 }
@@ -136,6 +147,50 @@ pub(crate) mod test_scenes {
                     }
                 };
                 Primitive { shape, material: 0 }
+            })
+            .collect()
+    }
+
+    /// Boxes, cylinders, disks, cones and quadrics under random affine transforms, and a
+    /// few unbounded planes (which every structure leaves to the scene).
+    pub fn analytic_soup(seed: u64, n: usize) -> Vec<Primitive> {
+        use crate::aabb::Aabb;
+        use crate::primitive::{Analytic, AnalyticKind};
+        let mut rng = Rng(seed);
+        (0..n)
+            .map(|i| {
+                let kind = match i % 6 {
+                    0 => AnalyticKind::Cuboid(Aabb::new(rng.vec(1.0), rng.vec(1.0))),
+                    1 => AnalyticKind::Cylinder {
+                        radius: rng.range(0.2, 1.0),
+                        zmin: rng.range(-1.0, 0.0),
+                        zmax: rng.range(0.1, 1.0),
+                    },
+                    2 => AnalyticKind::Disk {
+                        radius: rng.range(0.2, 1.0),
+                    },
+                    3 => AnalyticKind::Cone {
+                        radius: rng.range(0.2, 1.0),
+                        height: rng.range(-1.5, 1.5),
+                    },
+                    4 => AnalyticKind::Quadric {
+                        // x² + y² − z² − r² (a hyperboloid) clipped to a box.
+                        coefficients: [1.0, 1.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -rng.range(0.1, 0.5)],
+                        clip: Aabb::new(Vec3A::splat(-1.0), Vec3A::splat(1.0)),
+                    },
+                    _ if i % 60 == 5 => AnalyticKind::Plane {
+                        point: rng.vec(10.0),
+                        normal: rng.vec(1.0),
+                    },
+                    _ => AnalyticKind::Disk { radius: 0.5 },
+                };
+                let m = Affine3A::from_translation(rng.vec(10.0).into())
+                    * Affine3A::from_axis_angle(rng.vec(1.0).normalize().into(), rng.range(0.0, 6.0))
+                    * Affine3A::from_scale(Vec3::new(rng.range(0.3, 2.0), rng.range(0.3, 2.0), rng.range(0.3, 2.0)));
+                Primitive {
+                    shape: Shape::Analytic(Box::new(Analytic::new(m, kind))),
+                    material: 0,
+                }
             })
             .collect()
     }

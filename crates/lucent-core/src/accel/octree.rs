@@ -107,8 +107,9 @@ impl Builder<'_> {
 impl Octree {
     pub fn build(prims: &[Primitive]) -> Octree {
         let boxes: Vec<Aabb> = prims.iter().map(|p| p.bounds()).collect();
-        let scene = boxes.iter().fold(Aabb::EMPTY, |b, p| b.union(p));
-        if prims.is_empty() {
+        let items: Vec<u32> = super::bounded(prims).map(|(i, _)| i).collect();
+        let scene = items.iter().fold(Aabb::EMPTY, |b, &i| b.union(&boxes[i as usize]));
+        if items.is_empty() {
             return Octree {
                 bounds: Aabb::EMPTY,
                 nodes: Vec::new(),
@@ -125,7 +126,7 @@ impl Octree {
             nodes: vec![OctNode { first: 0, count: 0 }],
             prim_ids: Vec::new(),
         };
-        b.build(0, &bounds, (0..prims.len() as u32).collect(), 0);
+        b.build(0, &bounds, items, 0);
         Octree {
             bounds,
             nodes: b.nodes,

@@ -103,8 +103,9 @@ fn packets(n: usize) -> f32 {
     n.div_ceil(LANES) as f32
 }
 
-pub fn build(bounds: impl ExactSizeIterator<Item = Aabb>) -> BinaryTree {
-    let refs: Vec<BuildRef> = bounds.enumerate().map(|(i, b)| BuildRef::new(&b, i as u32)).collect();
+/// Builds over `(primitive index, bounds)` pairs.
+pub fn build(items: impl Iterator<Item = (u32, Aabb)>) -> BinaryTree {
+    let refs: Vec<BuildRef> = items.map(|(i, b)| BuildRef::new(&b, i)).collect();
     let mut tree = BinaryTree {
         nodes: Vec::with_capacity(refs.len() / 2 + 1),
         refs,

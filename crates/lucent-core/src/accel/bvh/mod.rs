@@ -61,7 +61,7 @@ impl Bvh {
 
     /// Builds for a given instruction set (tests use this to check every path).
     pub fn build_for(prims: &[Primitive], isa: Isa) -> Bvh {
-        let tree = binary::build(prims.iter().map(|p| p.bounds()));
+        let tree = binary::build(super::bounded(prims));
         let wide = wide::collapse(&tree, prims);
         #[cfg(target_arch = "x86_64")]
         assert!(
