@@ -5,13 +5,14 @@
 //! features, degenerate geometry) at the location of the command responsible.
 
 use glam::{DAffine3, DVec3};
+use lucent_core::aabb::Aabb;
 use lucent_core::accel::AccelKind;
 use lucent_core::camera::Camera;
 use lucent_core::integrator::whitted::Whitted;
 use lucent_core::integrator::Integrator;
 use lucent_core::light::Light;
 use lucent_core::math::Vec3A;
-use lucent_core::primitive::{Primitive, Shape, Sphere};
+use lucent_core::primitive::{Analytic, AnalyticKind, Primitive, Shape, Sphere};
 use lucent_core::scene::{Scene, SceneParts};
 use lucent_core::transform::Transform;
 
@@ -69,6 +70,14 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
             ShapeKind::Sphere { center, radius } => {
                 let m = t.m * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
                 Shape::Sphere(Sphere::new(Transform::to_f32(&m)))
+            }
+            ShapeKind::Plane { .. }
+            | ShapeKind::Box { .. }
+            | ShapeKind::Cylinder { .. }
+            | ShapeKind::Disk { .. }
+            | ShapeKind::Cone { .. }
+            | ShapeKind::Quadric { .. } => {
+                Shape::Analytic(Box::new(Analytic::new(Transform::to_f32(&t.m), analytic_kind(&s.kind))))
             }
             ShapeKind::Triangle { v } => {
                 let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
@@ -195,4 +204,34 @@ fn check_settings(desc: &SceneDesc, diags: &mut Diagnostics) {
 
 fn to_f32(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
+}
+
+/// The core's object-space description of an analytic shape (rounded to f32 once).
+fn analytic_kind(kind: &ShapeKind) -> AnalyticKind {
+    let v = |d: DVec3| to_f32(d);
+    let f = |x: f64| x as f32;
+    match *kind {
+        ShapeKind::Plane { point, normal } => AnalyticKind::Plane {
+            point: v(point),
+            normal: v(normal),
+        },
+        ShapeKind::Box { lo, hi } => AnalyticKind::Cuboid(Aabb::new(v(lo), v(hi))),
+        ShapeKind::Cylinder { radius, zmin, zmax } => AnalyticKind::Cylinder {
+            radius: f(radius),
+            zmin: f(zmin),
+            zmax: f(zmax),
+        },
+        ShapeKind::Disk { radius } => AnalyticKind::Disk { radius: f(radius) },
+        ShapeKind::Cone { radius, height } => AnalyticKind::Cone {
+            radius: f(radius),
+            height: f(height),
+        },
+        ShapeKind::Quadric { coefficients, lo, hi } => AnalyticKind::Quadric {
+            coefficients: coefficients.map(f),
+            clip: Aabb::new(v(lo), v(hi)),
+        },
+        ShapeKind::Sphere { .. } | ShapeKind::Triangle { .. } | ShapeKind::TriNormal { .. } => {
+            unreachable!("not an analytic shape")
+        }
+    }
 }

@@ -34,6 +34,12 @@ const COMMANDS: &[&str] = &[
     "output",
     "camera",
     "sphere",
+    "plane",
+    "box",
+    "cylinder",
+    "disk",
+    "cone",
+    "quadric",
     "maxverts",
     "maxvertnorms",
     "vertex",
@@ -69,12 +75,6 @@ const COMMANDS: &[&str] = &[
 /// Commands of lucent's extensions (`../shared/EXTENSIONS.md`) that this version does not
 /// implement yet. Using one is an error, never a silently different picture.
 const NOT_YET_IMPLEMENTED: &[&str] = &[
-    "plane",
-    "box",
-    "cylinder",
-    "disk",
-    "cone",
-    "quadric",
     "mesh",
     "subdivmesh",
     "bezierpatches",
@@ -334,6 +334,7 @@ impl Parser {
             }
             "camera" => self.camera(c),
             "sphere" => self.sphere(c),
+            "plane" | "box" | "cylinder" | "disk" | "cone" | "quadric" => self.analytic(c),
             "maxverts" | "maxvertnorms" => {
                 if let Some([n]) = self.ints::<1>(c) {
                     if n < 0 {
@@ -678,6 +679,115 @@ impl Parser {
             center: DVec3::new(v[0], v[1], v[2]),
             radius: v[3],
         };
+        self.shape(c, kind);
+    }
+
+    /// The shapes of the geometry extensions (EXTENSIONS.md): `plane`, `box`, `cylinder`,
+    /// `disk`, `cone`, `quadric`.
+    fn analytic(&mut self, c: &Command) {
+        let name = c.name.text.to_string();
+        let kind = match name.as_str() {
+            "plane" => {
+                let Some(v) = self.nums::<6>(c) else { return };
+                let normal = DVec3::new(v[3], v[4], v[5]);
+                if normal == DVec3::ZERO {
+                    self.err_span(c, 3, 3, "plane: the normal must not be zero");
+                    return;
+                }
+                ShapeKind::Plane {
+                    point: DVec3::new(v[0], v[1], v[2]),
+                    normal,
+                }
+            }
+            "box" => {
+                let Some(v) = self.nums::<6>(c) else { return };
+                let (a, b) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
+                if let Some(axis) = (0..3).find(|&k| a[k] == b[k]) {
+                    let msg = format!(
+                        "box: the corners have the same {} (the box would be flat)",
+                        ["x", "y", "z"][axis]
+                    );
+                    self.err_arg(c, 3 + axis, msg);
+                    return;
+                }
+                ShapeKind::Box {
+                    lo: a.min(b),
+                    hi: a.max(b),
+                }
+            }
+            "cylinder" => {
+                let Some([radius, zmin, zmax]) = self.nums::<3>(c) else {
+                    return;
+                };
+                if !(radius > 0.0) {
+                    self.err_arg(
+                        c,
+                        0,
+                        format!("cylinder: radius must be positive, got {}", c.args[0].text),
+                    );
+                    return;
+                }
+                if !(zmax > zmin) {
+                    self.err_arg(
+                        c,
+                        2,
+                        format!(
+                            "cylinder: zmax ({}) must be greater than zmin ({})",
+                            c.args[2].text, c.args[1].text
+                        ),
+                    );
+                    return;
+                }
+                ShapeKind::Cylinder { radius, zmin, zmax }
+            }
+            "disk" => {
+                let Some([radius]) = self.nums::<1>(c) else { return };
+                if !(radius > 0.0) {
+                    self.err_arg(c, 0, format!("disk: radius must be positive, got {}", c.args[0].text));
+                    return;
+                }
+                ShapeKind::Disk { radius }
+            }
+            "cone" => {
+                let Some([radius, height]) = self.nums::<2>(c) else {
+                    return;
+                };
+                if !(radius > 0.0) {
+                    self.err_arg(c, 0, format!("cone: radius must be positive, got {}", c.args[0].text));
+                    return;
+                }
+                if height == 0.0 {
+                    self.err_arg(c, 1, "cone: height must not be zero");
+                    return;
+                }
+                ShapeKind::Cone { radius, height }
+            }
+            _ => {
+                let Some(v) = self.nums::<16>(c) else { return };
+                let mut coefficients = [0.0; 10];
+                coefficients.copy_from_slice(&v[..10]);
+                if coefficients.iter().all(|&x| x == 0.0) {
+                    self.err_span(c, 0, 10, "quadric: all ten coefficients are zero (no surface)");
+                    return;
+                }
+                let (lo, hi) = (DVec3::new(v[10], v[11], v[12]), DVec3::new(v[13], v[14], v[15]));
+                if let Some(axis) = (0..3).find(|&k| !(hi[k] > lo[k])) {
+                    let xyz = ["x", "y", "z"][axis];
+                    let msg = format!(
+                        "quadric: the clip box needs {xyz}1 > {xyz}0, got {} and {}",
+                        c.args[13 + axis].text,
+                        c.args[10 + axis].text
+                    );
+                    self.err_arg(c, 13 + axis, msg);
+                    return;
+                }
+                ShapeKind::Quadric { coefficients, lo, hi }
+            }
+        };
+        if Transform::new(self.current.m).is_none() {
+            self.err_cmd(c, format!("{name}: the current transform is singular"));
+            return;
+        }
         self.shape(c, kind);
     }
 

@@ -76,6 +76,22 @@ pub enum ShapeKind {
     Triangle { v: [u32; 3] },
     /// Indices into [`SceneDesc::vertex_normals`].
     TriNormal { v: [u32; 3] },
+    /// `plane px py pz nx ny nz` (object space; the normal is not zero).
+    Plane { point: DVec3, normal: DVec3 },
+    /// `box`: the corners sorted so that `lo < hi` along every axis.
+    Box { lo: DVec3, hi: DVec3 },
+    /// `cylinder radius zmin zmax`, `radius > 0`, `zmin < zmax`.
+    Cylinder { radius: f64, zmin: f64, zmax: f64 },
+    /// `disk radius`, `radius > 0`.
+    Disk { radius: f64 },
+    /// `cone radius height`, `radius > 0`, `height ≠ 0`.
+    Cone { radius: f64, height: f64 },
+    /// `quadric a … j x0 y0 z0 x1 y1 z1`: coefficients (not all zero) and the clip box.
+    Quadric {
+        coefficients: [f64; 10],
+        lo: DVec3,
+        hi: DVec3,
+    },
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -300,3 +300,45 @@ fn thread_count_and_acceleration_structure_do_not_change_a_byte() {
     );
     assert_eq!(reference, render_bytes(&scene, AccelKind::List, 2), "bvh vs list");
 }
+
+#[test]
+fn a_rotated_cylinder_in_front_of_an_infinite_plane() {
+    // The cylinder x² + z² = 1, |y| ≤ 1.5 (object z axis turned onto world y), and the
+    // plane z = −3 behind it, lit head-on: N·L is the normal's z.
+    let scene = "size 60 40\ncamera 0 0 6 0 0 0 0 1 0 40\nambient 0.1 0.1 0.1\ndiffuse 0.6 0.5 0.4\ndirectional 0 0 1 1 1 1\nplane 0 0 -3 0 0 1\nrotate 1 0 0 -90\ncylinder 1 -1.5 1.5\n";
+    for accel in AccelKind::ALL {
+        let img = render_bytes(scene, accel, 2);
+        let eye = DVec3::new(0.0, 0.0, 6.0);
+        let shade = |nz: f64| [byte(0.1 + 0.6 * nz), byte(0.1 + 0.5 * nz), byte(0.1 + 0.4 * nz)];
+        let (mut side, mut floor) = (0, 0);
+        for i in 0..40 {
+            for j in 0..60 {
+                let d = camera_ray(eye, DVec3::ZERO, DVec3::Y, 40.0, 60, 40, j, i);
+                // Ray against the infinite cylinder x² + z² = 1.
+                let a = d.x * d.x + d.z * d.z;
+                let b = eye.x * d.x + eye.z * d.z;
+                let c = eye.x * eye.x + eye.z * eye.z - 1.0;
+                let disc = b * b - a * c;
+                let want = if disc > 0.0 {
+                    let t = (-b - disc.sqrt()) / a;
+                    let p = eye + d * t;
+                    if disc / (a * a) < 1e-3 || (p.y.abs() - 1.5).abs() < 0.05 {
+                        continue; // silhouette or rim
+                    }
+                    if p.y.abs() <= 1.5 {
+                        side += 1;
+                        shade(p.z.max(0.0))
+                    } else {
+                        floor += 1;
+                        shade(1.0)
+                    }
+                } else {
+                    floor += 1;
+                    shade(1.0)
+                };
+                assert_close(pixel(&img, j, i), want, &format!("{accel:?}: pixel ({j}, {i})"));
+            }
+        }
+        assert!(side > 200 && floor > 1000, "{side} {floor}");
+    }
+}

@@ -274,8 +274,8 @@ fn unknown_commands_warn_or_fail_in_strict_mode() {
 #[test]
 fn unsupported_features_are_errors_not_silent_differences() {
     assert_eq!(
-        first_error("plane 0 0 0 0 1 0"),
-        "t.test:3:1: error: plane: this lucent extension (docs/scene-format.md) is not implemented yet"
+        first_error("mesh dragon.obj"),
+        "t.test:3:1: error: mesh: this lucent extension (docs/scene-format.md) is not implemented yet"
     );
     assert_eq!(
         first_error("integrator pathtracer"),
@@ -335,4 +335,46 @@ fn state_is_captured_per_object() {
         }
         _ => panic!(),
     }
+}
+
+#[test]
+fn analytic_shapes() {
+    for (line, msg) in [
+        (
+            "plane 0 0 0 0 0 0",
+            "t.test:3:13: error: plane: the normal must not be zero",
+        ),
+        (
+            "plane 0 0 0 0 1",
+            "t.test:3:16: error: plane: expected 6 numbers, got 5 arguments",
+        ),
+        (
+            "box 0 0 0 1 0 1",
+            "t.test:3:13: error: box: the corners have the same y (the box would be flat)",
+        ),
+        (
+            "cylinder 0 0 1",
+            "t.test:3:10: error: cylinder: radius must be positive, got 0",
+        ),
+        (
+            "cylinder 1 2 1",
+            "t.test:3:14: error: cylinder: zmax (1) must be greater than zmin (2)",
+        ),
+        ("disk -1", "t.test:3:6: error: disk: radius must be positive, got -1"),
+        ("cone 1 0", "t.test:3:8: error: cone: height must not be zero"),
+        ("cone 1 x", "t.test:3:8: error: cone: 'x' is not a number"),
+        (
+            "quadric 0 0 0 0 0 0 0 0 0 0 -1 -1 -1 1 1 1",
+            "t.test:3:9: error: quadric: all ten coefficients are zero (no surface)",
+        ),
+        (
+            "quadric 1 1 1 0 0 0 0 0 0 -1 -1 -1 -1 1 1 -1",
+            "t.test:3:43: error: quadric: the clip box needs z1 > z0, got -1 and -1",
+        ),
+    ] {
+        assert_eq!(first_error(line), msg, "{line}");
+    }
+    // Valid forms parse without a word.
+    let ok = "plane 0 -1 0 0 1 0\nbox 1 1 1 -1 -1 -1\ncylinder 1 -1 1\ndisk 2\ncone 1 -2\nquadric 1 1 -1 0 0 0 0 0 0 -0.1 -1 -1 -1 1 1 1\n";
+    assert!(messages(&format!("{HEADER}{ok}"), true).is_empty());
 }
