@@ -1,6 +1,7 @@
 //! What traversal reports about the closest hit, and what shading needs from it.
 
 use crate::math::{Color, Vec3A};
+use glam::Vec2;
 
 /// The closest hit found by an acceleration structure.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,6 +33,8 @@ pub struct SurfacePoint {
     pub point: Vec3A,
     /// Unit shading normal, as the scene defines it (never flipped toward the viewer).
     pub normal: Vec3A,
+    /// Texture coordinates (conventions in [`crate::shape::texcoord`]).
+    pub uv: Vec2,
     pub material: u32,
 }
 

@@ -5,7 +5,8 @@ use crate::aabb::Aabb;
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Affine3A, Mat3A, Vec3A};
 use crate::ray::PreparedRay;
-use crate::shape::{cone, cuboid, cylinder, disk, plane, quadric, sphere, triangle};
+use crate::shape::{cone, cuboid, cylinder, disk, plane, quadric, sphere, texcoord, triangle};
+use glam::Vec2;
 
 /// A sphere or ellipsoid: the unit sphere mapped by an affine object-to-world transform.
 #[derive(Clone, Copy, Debug)]
@@ -86,6 +87,18 @@ impl AnalyticKind {
             AnalyticKind::Disk { radius } => disk::intersect(*radius, o, d, t_min, t_max),
             AnalyticKind::Cone { radius, height } => cone::intersect(*radius, *height, o, d, t_min, t_max),
             AnalyticKind::Quadric { coefficients, clip } => quadric::intersect(coefficients, clip, o, d, t_min, t_max),
+        }
+    }
+
+    /// Texture coordinates at an object-space surface point with object normal `n`.
+    fn uv(&self, p: Vec3A, n: Vec3A) -> Vec2 {
+        match self {
+            AnalyticKind::Plane { point, normal } => texcoord::plane(*point, *normal, p),
+            AnalyticKind::Cuboid(b) => texcoord::cuboid(b, n, p),
+            AnalyticKind::Cylinder { zmin, zmax, .. } => texcoord::cylinder(p, *zmin, *zmax),
+            AnalyticKind::Disk { radius } => texcoord::disk(p, *radius),
+            AnalyticKind::Cone { height, .. } => texcoord::cone(p, *height),
+            AnalyticKind::Quadric { clip, .. } => texcoord::quadric(clip, p),
         }
     }
 
@@ -194,28 +207,33 @@ impl Primitive {
     /// Shading data at a hit of `origin + t·dir` on this primitive.
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A, vertex_normals: &[[Vec3A; 3]]) -> SurfacePoint {
         let point = origin + dir * hit.t;
-        let normal = match &self.shape {
-            Shape::Triangle { p, normals: None } => triangle::geometric_normal(p[0], p[1], p[2]),
+        let barycentric = Vec2::new(hit.b1, hit.b2);
+        let (normal, uv) = match &self.shape {
+            Shape::Triangle { p, normals: None } => (triangle::geometric_normal(p[0], p[1], p[2]), barycentric),
             Shape::Triangle { normals: Some(i), .. } => {
                 let n = &vertex_normals[*i as usize];
                 let b0 = 1.0 - hit.b1 - hit.b2;
-                (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize()
+                ((n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize(), barycentric)
             }
             Shape::Sphere(s) => {
                 // The object-space hit point is the object-space normal of the unit sphere.
                 let o = s.world_to_object.transform_point3a(origin);
                 let d = s.world_to_object.transform_vector3a(dir);
-                (s.normal_to_world * (o + d * hit.t)).normalize()
+                let p = o + d * hit.t;
+                ((s.normal_to_world * p).normalize(), texcoord::sphere(p.normalize()))
             }
             Shape::Analytic(a) => {
                 let o = a.world_to_object.transform_point3a(origin);
                 let d = a.world_to_object.transform_vector3a(dir);
-                (a.normal_to_world * a.kind.normal(o + d * hit.t)).normalize()
+                let p = o + d * hit.t;
+                let n = a.kind.normal(p);
+                ((a.normal_to_world * n).normalize(), a.kind.uv(p, n))
             }
         };
         SurfacePoint {
             point,
             normal,
+            uv,
             material: self.material,
         }
     }
@@ -251,5 +269,43 @@ mod tests {
         // Gradient of x² + y²/4 + z² is (2x, y/2, 2z) ∝ (x, y/4, z).
         let expect = Vec3A::new(0.5, 0.0, 0.75f32.sqrt()).normalize();
         assert!((sp.normal - expect).length() < 1e-5, "{}", sp.normal);
+    }
+
+    #[test]
+    fn analytic_shapes_shade_in_object_space() {
+        // A cylinder of radius 1, z in [0, 2], turned by R_x(−90°) (object z → world +y,
+        // object y → world −z) and moved to x = 5. A ray along −z at (5, 1.5, 10) meets it
+        // at world (5, 1.5, 1) = object (0, −1, 1.5): longitude 3/4, v = 1.5 / 2, and the
+        // object normal (0, −1, 0) comes back as world +z.
+        let m = Affine3A::from_translation(glam::Vec3::new(5.0, 0.0, 0.0))
+            * Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+        let prim = Primitive {
+            shape: Shape::Analytic(Box::new(Analytic::new(
+                m,
+                AnalyticKind::Cylinder {
+                    radius: 1.0,
+                    zmin: 0.0,
+                    zmax: 2.0,
+                },
+            ))),
+            material: 0,
+        };
+        // World bounds: x 4..6, y 0..2, z −1..1.
+        let b = prim.bounds();
+        assert!(
+            (b.min - Vec3A::new(4.0, 0.0, -1.0)).length() < 1e-5 && (b.max - Vec3A::new(6.0, 2.0, 1.0)).length() < 1e-5
+        );
+        let ray = Ray::segment(Vec3A::new(5.0, 1.5, 10.0), -Vec3A::Z, 1e-4, f32::INFINITY);
+        let (t, _, _) = prim.intersect(&PreparedRay::new(ray), f32::INFINITY).unwrap();
+        assert!((t - 9.0).abs() < 1e-5, "{t}");
+        let hit = Hit {
+            t,
+            prim: 0,
+            b1: 0.0,
+            b2: 0.0,
+        };
+        let sp = prim.surface_point(&hit, ray.origin, ray.dir, &[]);
+        assert!((sp.normal - Vec3A::Z).length() < 1e-5, "{}", sp.normal);
+        assert!((sp.uv - glam::Vec2::new(0.75, 0.75)).length() < 1e-5, "{}", sp.uv);
     }
 }

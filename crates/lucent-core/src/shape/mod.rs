@@ -10,4 +10,5 @@ pub mod plane;
 pub mod quadratic;
 pub mod quadric;
 pub mod sphere;
+pub mod texcoord;
 pub mod triangle;
