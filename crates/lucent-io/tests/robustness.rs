@@ -5,7 +5,7 @@
 use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_bytes, ParseOptions};
 
-const SEED_SCENE: &str = "size 16 12\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 3\nattenuation 1 0.1 0.01\npoint 1 2 3 1 1 1\ndirectional 0 1 1 .5 .5 .5\nmaxverts 4\nvertex -1 -1 0\nvertex 1 -1 0\nvertex 1 1 0\nvertexnormal 0 0 0 0 0 1\nvertexnormal 1 0 0 0 1 1\nvertexnormal 0 1 0 1 0 1\ndiffuse 0.5 0.2 0.1\nspecular .3 .3 .3\nshininess 20\npushTransform\nrotate 0 1 0 30\nscale 1 2 0.5\nsphere 0 0 0 1\ntri 0 1 2\ntrinormal 0 1 2\npopTransform\nintegrator raytracer\ngamma 2.2\n";
+const SEED_SCENE: &str = "size 16 12\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 3\nattenuation 1 0.1 0.01\npoint 1 2 3 1 1 1\ndirectional 0 1 1 .5 .5 .5\nmaxverts 4\nvertex -1 -1 0\nvertex 1 -1 0\nvertex 1 1 0\nvertexnormal 0 0 0 0 0 1\nvertexnormal 1 0 0 0 1 1\nvertexnormal 0 1 0 1 0 1\ndiffuse 0.5 0.2 0.1\nspecular .3 .3 .3\nshininess 20\npushTransform\nrotate 0 1 0 30\nscale 1 2 0.5\nsphere 0 0 0 1\ntri 0 1 2\ntrinormal 0 1 2\npopTransform\nplane 0 -1 0 0 1 0\nbox -1 -1 -1 1 1 1\ncylinder 1 -1 1\ndisk 1\ncone 1 2\nquadric 1 1 -1 0 0 0 0 0 0 -0.1 -1 -1 -1 1 1 1\nintegrator raytracer\ngamma 2.2\n";
 
 struct Rng(u64);
 impl Rng {
@@ -39,6 +39,12 @@ const INTERESTING: &[&str] = &[
     "pushTransform",
     "tri",
     "sphere",
+    "plane",
+    "box",
+    "cylinder",
+    "disk",
+    "cone",
+    "quadric",
     "size",
     "4294967296",
     "-2147483649",
@@ -48,6 +54,12 @@ const INTERESTING: &[&str] = &[
 
 #[test]
 fn random_mutations_never_panic() {
+    let (seed, seed_diags) = parse_bytes("seed.test", SEED_SCENE.as_bytes(), ParseOptions { strict: true });
+    assert!(
+        !seed_diags.has_errors() && seed.shapes.len() == 9,
+        "{}",
+        seed_diags.render(&seed.sources)
+    );
     let mut rng = Rng(0x5eed);
     let tokens: Vec<&str> = SEED_SCENE.split([' ', '\n']).collect();
     for _ in 0..3000 {
@@ -83,9 +95,16 @@ fn random_mutations_never_panic() {
         if !diags.has_errors() {
             // Keep the render cheap: whatever size survived, shrink it.
             if let Some(built) = build(&desc, &BuildOptions::default(), &mut diags) {
+                // A few rays across the picture, with the shading data of what they hit.
                 let scene = built.scene;
-                let ray = scene.camera.ray(0.5, 0.5);
-                let _ = scene.closest_hit(&ray);
+                for k in 0..16 {
+                    let (x, y) = ((k % 4) as f64 * 4.0 + 0.5, (k / 4) as f64 * 3.0 + 0.5);
+                    let ray = scene.camera.ray(x, y);
+                    if let Some(hit) = scene.closest_hit(&ray) {
+                        let _ = scene.surface_point(&hit, &ray);
+                    }
+                    let _ = scene.occluded(&ray);
+                }
             }
         }
         let _ = diags.render(&desc.sources);
