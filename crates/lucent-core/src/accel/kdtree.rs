@@ -14,6 +14,7 @@
 //! is pushed with its part of the interval; as soon as the closest hit lies before the
 //! entry of the next node to visit, the search stops.
 
+use super::cell_walk::{self, CellWalk};
 use super::overlap::{cell_padding, clipped_bounds, overlaps, padded};
 use super::{search_limit, Accelerator};
 use crate::aabb::Aabb;
@@ -41,6 +42,8 @@ pub struct KdTree {
     nodes: Vec<KdNode>,
     prim_ids: Vec<u32>,
     bounds: Aabb,
+    /// The scene's primitive count (the mailbox's size).
+    prim_count: usize,
 }
 
 struct Item {
@@ -76,6 +79,7 @@ impl KdTree {
             nodes: builder.nodes,
             prim_ids: builder.prim_ids,
             bounds,
+            prim_count: prims.len(),
         }
     }
 
@@ -206,9 +210,9 @@ fn best_plane(node_box: &Aabb, items: &[Item]) -> Option<(usize, f32)> {
     (cost < INTERSECTION_COST * n as f32).then_some((axis, pos))
 }
 
-impl KdTree {
-    /// Visits the leaves the ray crosses, front to back; `leaf` returns the distance
-    /// beyond which nothing more can be found (or `None` to stop at once).
+impl KdTree {}
+
+impl CellWalk for KdTree {
     #[inline(always)]
     fn walk(&self, ray: &Ray, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
         if self.nodes.is_empty() {
@@ -263,37 +267,18 @@ impl KdTree {
             }
         }
     }
+    fn prim_count(&self) -> usize {
+        self.prim_count
+    }
 }
 
 impl Accelerator for KdTree {
     fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
-        let r = PreparedRay::new(*ray);
-        let mut best: Option<Hit> = None;
-        let mut t_max = ray.t_max;
-        self.walk(ray, |ids| {
-            for &pi in ids {
-                if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
-                    if Hit::is_closer_than(t, pi, &best) {
-                        best = Some(Hit { t, prim: pi, b1, b2 });
-                        t_max = t;
-                    }
-                }
-            }
-            Some(best.map_or(f32::INFINITY, |h| search_limit(h.t)))
-        });
-        best
+        cell_walk::closest_hit(self, prims, ray)
     }
 
     fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
-        let r = PreparedRay::new(*ray);
-        let mut hit = false;
-        self.walk(ray, |ids| {
-            hit = ids
-                .iter()
-                .any(|&pi| prims[pi as usize].intersect(&r, ray.t_max).is_some());
-            (!hit).then_some(f32::INFINITY)
-        });
-        hit
+        cell_walk::occluded(self, prims, ray)
     }
 
     fn memory_bytes(&self) -> usize {

@@ -7,6 +7,7 @@
 //! `t` go to the primitive that comes first in the scene ([`Hit::is_closer_than`]).
 
 pub mod bvh;
+mod cell_walk;
 pub mod grid;
 pub mod kdtree;
 pub mod list;

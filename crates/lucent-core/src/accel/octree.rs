@@ -12,7 +12,7 @@
 //! its own part of the ray's interval. The search ends when the closest hit lies before
 //! the next octant.
 
-use super::mailbox::Mailbox;
+use super::cell_walk::{self, CellWalk};
 use super::overlap::{cell_padding, overlaps, padded};
 use super::{search_limit, Accelerator};
 use crate::aabb::Aabb;
@@ -138,9 +138,9 @@ impl Octree {
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
+}
 
-    /// Visits the leaves the ray crosses, in order; `leaf` gets a leaf's primitives and
-    /// returns the distance beyond which nothing more can be found (`None`: stop).
+impl CellWalk for Octree {
     #[inline(always)]
     fn walk(&self, ray: &Ray, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
         if self.nodes.is_empty() {
@@ -209,44 +209,18 @@ impl Octree {
             }
         }
     }
+    fn prim_count(&self) -> usize {
+        self.prim_count
+    }
 }
 
 impl Accelerator for Octree {
     fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
-        let r = PreparedRay::new(*ray);
-        let mut best: Option<Hit> = None;
-        let mut t_max = ray.t_max;
-        Mailbox::with(self.prim_count, |mailbox| {
-            self.walk(ray, |ids| {
-                for &pi in ids {
-                    if !mailbox.first_visit(pi) {
-                        continue;
-                    }
-                    if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
-                        if Hit::is_closer_than(t, pi, &best) {
-                            best = Some(Hit { t, prim: pi, b1, b2 });
-                            t_max = t;
-                        }
-                    }
-                }
-                Some(best.map_or(f32::INFINITY, |h| search_limit(h.t)))
-            })
-        });
-        best
+        cell_walk::closest_hit(self, prims, ray)
     }
 
     fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
-        let r = PreparedRay::new(*ray);
-        let mut hit = false;
-        Mailbox::with(self.prim_count, |mailbox| {
-            self.walk(ray, |ids| {
-                hit = ids
-                    .iter()
-                    .any(|&pi| mailbox.first_visit(pi) && prims[pi as usize].intersect(&r, ray.t_max).is_some());
-                (!hit).then_some(f32::INFINITY)
-            })
-        });
-        hit
+        cell_walk::occluded(self, prims, ray)
     }
 
     fn memory_bytes(&self) -> usize {

@@ -1,0 +1,56 @@
+//! What the grid, the octree and the kd-tree share. Each visits its cells (leaves) in
+//! order along the ray, every cell holding a list of primitives that may also appear in
+//! other cells; the closest-hit and any-hit queries on top of such a walk are the same
+//! for all three: test each primitive once per ray ([`Mailbox`]), keep the closest hit
+//! with the scene-order tie rule, and stop once it lies before the next cell.
+
+use super::mailbox::Mailbox;
+use super::search_limit;
+use crate::hit::Hit;
+use crate::primitive::Primitive;
+use crate::ray::{PreparedRay, Ray};
+
+pub trait CellWalk {
+    /// Visits the cells `ray` crosses, nearest first. `cell` gets a cell's primitives and
+    /// returns the distance beyond which nothing more can be found; `None` stops the walk.
+    fn walk(&self, ray: &Ray, cell: impl FnMut(&[u32]) -> Option<f32>);
+    /// One more than the largest primitive index the cells hold (the mailbox's size).
+    fn prim_count(&self) -> usize;
+}
+
+pub fn closest_hit(w: &impl CellWalk, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+    let r = PreparedRay::new(*ray);
+    let mut best: Option<Hit> = None;
+    let mut t_max = ray.t_max;
+    Mailbox::with(w.prim_count(), |mailbox| {
+        w.walk(ray, |ids| {
+            for &pi in ids {
+                if !mailbox.first_visit(pi) {
+                    continue;
+                }
+                if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
+                    if Hit::is_closer_than(t, pi, &best) {
+                        best = Some(Hit { t, prim: pi, b1, b2 });
+                        t_max = t;
+                    }
+                }
+            }
+            Some(best.map_or(f32::INFINITY, |h| search_limit(h.t)))
+        })
+    });
+    best
+}
+
+pub fn occluded(w: &impl CellWalk, prims: &[Primitive], ray: &Ray) -> bool {
+    let r = PreparedRay::new(*ray);
+    let mut hit = false;
+    Mailbox::with(w.prim_count(), |mailbox| {
+        w.walk(ray, |ids| {
+            hit = ids
+                .iter()
+                .any(|&pi| mailbox.first_visit(pi) && prims[pi as usize].intersect(&r, ray.t_max).is_some());
+            (!hit).then_some(f32::INFINITY)
+        })
+    });
+    hit
+}
