@@ -32,7 +32,7 @@ bin=$root/target/release/lucent
 echo "== Embree 3 vs lucent bvh (1 thread) =="
 bash "$bench/compare.sh" "$bin" "${meshes[@]}"
 
-echo "== every structure (lucent bench rays; list on the first 2,000 rays) =="
+echo "== every structure (lucent bench rays; list on 2,000 rays spread over each set) =="
 for mesh in "${meshes[@]}"; do
     name=$(basename "$mesh" .gz); name=${name%.obj}
     obj=$mesh; [[ $mesh == *.gz ]] && obj=$WORK/$name.obj
