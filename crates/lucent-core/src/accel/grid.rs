@@ -181,6 +181,7 @@ impl CellWalk for Grid {
             next_t[a] = (wall(w, a) - ray.origin[a]) * r.inv_dir[a];
         }
     }
+
     fn prim_count(&self) -> usize {
         self.prim_count
     }

@@ -267,6 +267,7 @@ impl CellWalk for KdTree {
             }
         }
     }
+
     fn prim_count(&self) -> usize {
         self.prim_count
     }

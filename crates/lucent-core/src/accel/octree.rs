@@ -209,6 +209,7 @@ impl CellWalk for Octree {
             }
         }
     }
+
     fn prim_count(&self) -> usize {
         self.prim_count
     }
