@@ -83,6 +83,20 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
                 let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
                 Shape::Triangle { p, normals: None }
             }
+            ShapeKind::TessellatedTri { v } => {
+                let p = v.map(|i| to_f32(t.point(desc.tessellated[i as usize].0)));
+                let n = v.map(|i| to_f32(t.normal(desc.tessellated[i as usize].1).normalize()));
+                // A fully degenerate patch has no normals: shade it flat.
+                if n.iter().all(|n| n.is_finite()) {
+                    vertex_normals.push(n);
+                    Shape::Triangle {
+                        p,
+                        normals: Some(vertex_normals.len() as u32 - 1),
+                    }
+                } else {
+                    Shape::Triangle { p, normals: None }
+                }
+            }
             ShapeKind::TriNormal { v } => {
                 let p = v.map(|i| to_f32(t.point(desc.vertex_normals[i as usize].0)));
                 let n = v.map(|i| to_f32(t.normal(desc.vertex_normals[i as usize].1).normalize()));
@@ -96,7 +110,11 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         if let Shape::Triangle { p, normals } = &shape {
             let n = (p[1] - p[0]).cross(p[2] - p[0]);
             if !(n.length_squared() > 0.0) || !n.is_finite() {
-                diags.warning(s.loc, "degenerate triangle (zero area) skipped");
+                // A sliver of a tessellated surface is an artefact of rounding, not a
+                // mistake in the scene: dropped without a word.
+                if !matches!(s.kind, ShapeKind::TessellatedTri { .. }) {
+                    diags.warning(s.loc, "degenerate triangle (zero area) skipped");
+                }
                 if normals.is_some() {
                     vertex_normals.pop();
                 }
@@ -230,7 +248,10 @@ fn analytic_kind(kind: &ShapeKind) -> AnalyticKind {
             coefficients: coefficients.map(f),
             clip: Aabb::new(v(lo), v(hi)),
         },
-        ShapeKind::Sphere { .. } | ShapeKind::Triangle { .. } | ShapeKind::TriNormal { .. } => {
+        ShapeKind::Sphere { .. }
+        | ShapeKind::Triangle { .. }
+        | ShapeKind::TriNormal { .. }
+        | ShapeKind::TessellatedTri { .. } => {
             unreachable!("not an analytic shape")
         }
     }

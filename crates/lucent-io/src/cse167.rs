@@ -40,6 +40,7 @@ const COMMANDS: &[&str] = &[
     "disk",
     "cone",
     "quadric",
+    "bezierpatches",
     "maxverts",
     "maxvertnorms",
     "vertex",
@@ -77,7 +78,6 @@ const COMMANDS: &[&str] = &[
 const NOT_YET_IMPLEMENTED: &[&str] = &[
     "mesh",
     "subdivmesh",
-    "bezierpatches",
     "nurbs",
     "knotsu",
     "knotsv",
@@ -140,6 +140,7 @@ pub fn parse_bytes(name: &str, bytes: &[u8], options: ParseOptions) -> (SceneDes
         .map(|l| String::from_utf8_lossy(l).into_owned())
         .collect();
     let mut p = Parser::new(options);
+    p.base_dir = Path::new(name).parent().map(Path::to_path_buf).unwrap_or_default();
     p.file = p.desc.sources.add(name.to_string(), shown);
     for (i, raw) in raw_lines.iter().enumerate() {
         if p.diags.too_many_errors() {
@@ -177,6 +178,8 @@ struct Command<'a> {
 }
 
 struct Parser {
+    /// Where files named by the scene are looked for: the scene file's directory.
+    base_dir: std::path::PathBuf,
     desc: SceneDesc,
     diags: Diagnostics,
     options: ParseOptions,
@@ -200,6 +203,7 @@ struct Parser {
 impl Parser {
     fn new(options: ParseOptions) -> Parser {
         Parser {
+            base_dir: std::path::PathBuf::new(),
             desc: SceneDesc::default(),
             diags: Diagnostics::default(),
             options,
@@ -335,6 +339,7 @@ impl Parser {
             "camera" => self.camera(c),
             "sphere" => self.sphere(c),
             "plane" | "box" | "cylinder" | "disk" | "cone" | "quadric" => self.analytic(c),
+            "bezierpatches" => self.bezier_patches(c),
             "maxverts" | "maxvertnorms" => {
                 if let Some([n]) = self.ints::<1>(c) {
                     if n < 0 {
@@ -789,6 +794,82 @@ impl Parser {
             return;
         }
         self.shape(c, kind);
+    }
+
+    /// `bezierpatches file [divisions]`: the patches of `file`, each tessellated into
+    /// `divisions × divisions` quads (two triangles each) with normals from the exact
+    /// derivatives, under the current transform and material.
+    fn bezier_patches(&mut self, c: &Command) {
+        if c.args.is_empty() || c.args.len() > 2 {
+            let n = c.args.len();
+            self.err_cmd(
+                c,
+                format!("bezierpatches: expected a file name and optionally a number of divisions, got {n} arguments"),
+            );
+            return;
+        }
+        let divisions = match c.args.get(1) {
+            None => 16,
+            Some(tok) => match self.integer(c, tok) {
+                Some(d) if (1..=256).contains(&d) => d as u32,
+                Some(d) => {
+                    self.err_arg(
+                        c,
+                        1,
+                        format!("bezierpatches: divisions must be between 1 and 256, got {d}"),
+                    );
+                    return;
+                }
+                None => return,
+            },
+        };
+        let name = c.args[0].text.to_string();
+        let path = self.base_dir.join(&name);
+        let text = match std::fs::read(&path) {
+            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Err(e) => {
+                self.err_arg(
+                    c,
+                    0,
+                    format!("bezierpatches: cannot read '{}': {}", path.display(), io_reason(&e)),
+                );
+                return;
+            }
+        };
+        let patches = match crate::patches::parse_patches(&text) {
+            Ok(p) => p,
+            Err(e) => {
+                let at = if e.line > 0 {
+                    format!(":{}", e.line)
+                } else {
+                    String::new()
+                };
+                self.err_arg(c, 0, format!("bezierpatches: {}{at}: {}", path.display(), e.message));
+                return;
+            }
+        };
+        let n = divisions as usize + 1;
+        for patch in &patches.patches {
+            let base = self.desc.tessellated.len() as u32;
+            self.desc
+                .tessellated
+                .extend(lucent_core::shape::bezier::tessellate(patch, divisions));
+            let at = |i: usize, j: usize| base + (i * n + j) as u32;
+            for i in 0..n - 1 {
+                for j in 0..n - 1 {
+                    for v in [
+                        [at(i, j), at(i, j + 1), at(i + 1, j + 1)],
+                        [at(i, j), at(i + 1, j + 1), at(i + 1, j)],
+                    ] {
+                        // Quads at a pole have a collapsed edge: drop their empty triangles.
+                        let p = v.map(|k| self.desc.tessellated[k as usize].0);
+                        if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 0.0 {
+                            self.shape(c, ShapeKind::TessellatedTri { v });
+                        }
+                    }
+                }
+            }
+        }
     }
 
     fn triangle(&mut self, c: &Command) {

@@ -86,6 +86,8 @@ pub enum ShapeKind {
     Disk { radius: f64 },
     /// `cone radius height`, `radius > 0`, `height ≠ 0`.
     Cone { radius: f64, height: f64 },
+    /// A triangle of a tessellated surface: indices into [`SceneDesc::tessellated`].
+    TessellatedTri { v: [u32; 3] },
     /// `quadric a … j x0 y0 z0 x1 y1 z1`: coefficients (not all zero) and the clip box.
     Quadric {
         coefficients: [f64; 10],
@@ -166,6 +168,9 @@ pub struct SceneDesc {
     pub vertices: Vec<DVec3>,
     /// The `vertexnormal` pile: position and normal, untransformed.
     pub vertex_normals: Vec<(DVec3, DVec3)>,
+    /// Points and unit normals of tessellated surfaces (`bezierpatches`), in object space:
+    /// a pile of its own, so that the `vertexnormal` numbering stays the scene's.
+    pub tessellated: Vec<(DVec3, DVec3)>,
     /// Transforms captured by shapes and lights (deduplicated while parsing).
     pub transforms: Vec<Transform>,
     /// Materials captured by shapes (deduplicated while parsing).

@@ -15,3 +15,4 @@ pub mod diag;
 pub mod image;
 pub mod mesh;
 mod number;
+pub mod patches;

@@ -378,3 +378,63 @@ fn analytic_shapes() {
     let ok = "plane 0 -1 0 0 1 0\nbox 1 1 1 -1 -1 -1\ncylinder 1 -1 1\ndisk 2\ncone 1 -2\nquadric 1 1 -1 0 0 0 0 0 0 -0.1 -1 -1 -1 1 1 1\n";
     assert!(messages(&format!("{HEADER}{ok}"), true).is_empty());
 }
+
+#[test]
+fn bezier_patch_files() {
+    let dir = std::env::temp_dir().join(format!("lucent-patches-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("bad.bpt"),
+        "1\n1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16\n2\n0 0 0\n1 1\n",
+    )
+    .unwrap();
+    let scene = dir.join("s.test");
+    let name = scene.display().to_string();
+    let errors = |line: &str| -> Vec<String> {
+        let text = format!("{HEADER}{line}\n");
+        let (_, diags) = parse_bytes(&name, text.as_bytes(), ParseOptions::default());
+        diags
+            .items
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .map(|d| format!("{}:{}: {}", d.loc.line, d.loc.col, d.message))
+            .collect()
+    };
+    let bad = dir.join("bad.bpt").display().to_string();
+    let missing = dir.join("missing.bpt").display().to_string();
+    assert_eq!(
+        errors("bezierpatches missing.bpt"),
+        [format!("3:15: bezierpatches: cannot read '{missing}': no such file")]
+    );
+    assert_eq!(
+        errors("bezierpatches bad.bpt"),
+        [format!(
+            "3:15: bezierpatches: {bad}:5: point 2: expected three numbers x y z"
+        )]
+    );
+    assert_eq!(
+        errors("bezierpatches bad.bpt 0"),
+        ["3:23: bezierpatches: divisions must be between 1 and 256, got 0"]
+    );
+    assert_eq!(
+        errors("bezierpatches"),
+        ["3:1: bezierpatches: expected a file name and optionally a number of divisions, got 0 arguments"]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_shipped_teapot_scene_tessellates() {
+    // 32 patches × 16 × 16 quads × 2 triangles, less the empty ones at the poles.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.test");
+    let (desc, diags) = lucent_io::cse167::parse_file(&path, ParseOptions { strict: true });
+    assert!(
+        !diags.has_errors() && diags.items.is_empty(),
+        "{}",
+        diags.render(&desc.sources)
+    );
+    let tris = desc.shapes.len() - 1; // and the floor plane
+    assert!((16_000..=16_384).contains(&tris), "{tris}");
+    assert_eq!(desc.tessellated.len(), 32 * 17 * 17);
+    assert!(desc.tessellated.iter().all(|(_, n)| (n.length() - 1.0).abs() < 1e-9));
+}

@@ -2,6 +2,7 @@
 //! and is tested against analytic answers; [`crate::primitive`] wraps them as the
 //! primitives a scene holds.
 
+pub mod bezier;
 pub mod cone;
 pub mod cuboid;
 pub mod cylinder;
