@@ -63,9 +63,27 @@ pub fn run(args: &CheckArgs) -> u8 {
         desc.integrator().name(),
         desc.max_depth()
     );
+    // The other kinds are named only when the scene has them.
+    let others: Vec<String> = [
+        ("plane", count(&|k| matches!(k, ShapeKind::Plane { .. }))),
+        ("box", count(&|k| matches!(k, ShapeKind::Box { .. }))),
+        ("cylinder", count(&|k| matches!(k, ShapeKind::Cylinder { .. }))),
+        ("disk", count(&|k| matches!(k, ShapeKind::Disk { .. }))),
+        ("cone", count(&|k| matches!(k, ShapeKind::Cone { .. }))),
+        ("quadric", count(&|k| matches!(k, ShapeKind::Quadric { .. }))),
+        (
+            "patch triangle",
+            count(&|k| matches!(k, ShapeKind::TessellatedTri { .. })),
+        ),
+    ]
+    .into_iter()
+    .filter(|&(_, n)| n > 0)
+    .map(|(name, n)| format!(", {n} {name}{}", if n == 1 { "" } else { "s" }))
+    .collect();
     println!(
-        "objects:    {spheres} spheres, {} triangles ({trinormals} with vertex normals)",
-        tris + trinormals
+        "objects:    {spheres} spheres, {} triangles ({trinormals} with vertex normals){}",
+        tris + trinormals,
+        others.concat()
     );
     println!("primitives: {} after build", built.scene.primitives.len());
     println!(

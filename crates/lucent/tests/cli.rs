@@ -160,8 +160,23 @@ fn check_summarises_and_reports_errors_like_render() {
     assert!(o.status.success());
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("size:       32 x 24"), "{out}");
-    assert!(out.contains("objects:    1 spheres, 1 triangles"), "{out}");
+    assert!(
+        out.contains("objects:    1 spheres, 1 triangles (0 with vertex normals)\n"),
+        "{out}"
+    );
     assert!(out.contains("lights:     1 point, 0 directional, 0 quad"), "{out}");
+    // The extension shapes are named when present.
+    fs::write(
+        dir.join("s.test"),
+        format!("{SCENE}plane 0 0 0 0 1 0\ndisk 1\ndisk 2\n"),
+    )
+    .unwrap();
+    let o = lucent(&dir, &["check", "s.test"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("objects:    1 spheres, 1 triangles (0 with vertex normals), 1 plane, 2 disks\n"),
+        "{out}"
+    );
     fs::write(dir.join("bad.test"), "size 10 10\npopTransform\n").unwrap();
     let o = lucent(&dir, &["check", "bad.test"]);
     assert_eq!(o.status.code(), Some(2));
