@@ -66,6 +66,11 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
     let mut vertex_normals = Vec::new();
     for s in &desc.shapes {
         let t = &desc.transforms[s.transform as usize];
+        if let ShapeKind::Nurbs { index } = s.kind {
+            let surface = &desc.nurbs[index as usize];
+            add_nurbs(surface, t, s.material, &c, height, &mut primitives, &mut vertex_normals);
+            continue;
+        }
         let shape = match s.kind {
             ShapeKind::Sphere { center, radius } => {
                 let m = t.m * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
@@ -83,6 +88,7 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
                 let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
                 Shape::Triangle { p, normals: None }
             }
+            ShapeKind::Nurbs { .. } => unreachable!("expanded above"),
             ShapeKind::TessellatedTri { v } => {
                 let p = v.map(|i| to_f32(t.point(desc.tessellated[i as usize].0)));
                 let n = v.map(|i| to_f32(t.normal(desc.tessellated[i as usize].1).normalize()));
@@ -251,8 +257,71 @@ fn analytic_kind(kind: &ShapeKind) -> AnalyticKind {
         ShapeKind::Sphere { .. }
         | ShapeKind::Triangle { .. }
         | ShapeKind::TriNormal { .. }
-        | ShapeKind::TessellatedTri { .. } => {
+        | ShapeKind::TessellatedTri { .. }
+        | ShapeKind::Nurbs { .. } => {
             unreachable!("not an analytic shape")
+        }
+    }
+}
+
+/// Tessellates a NURBS surface finely enough that no chord strays more than a quarter of
+/// a pixel from the surface where it is nearest to the camera, and adds the triangles,
+/// with normals from the exact derivatives.
+fn add_nurbs(
+    surface: &lucent_core::shape::nurbs::NurbsSurface,
+    t: &Transform,
+    material: u32,
+    camera: &crate::desc::CameraDesc,
+    height: u32,
+    primitives: &mut Vec<Primitive>,
+    vertex_normals: &mut Vec<[Vec3A; 3]>,
+) {
+    // With positive weights the surface lies in the hull of its control points.
+    let corners: Vec<DVec3> = surface.points.iter().map(|p| t.point(p.truncate() / p.w)).collect();
+    let (lo, hi) = corners
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let nearest = (camera.eye.clamp(lo, hi) - camera.eye)
+        .length()
+        .max(1e-3 * (hi - lo).length());
+    let pixel = 2.0 * nearest * (camera.fovy.to_radians() / 2.0).tan() / height as f64;
+    // Object-space tolerance: divide by the largest stretch of the transform.
+    let m = t.m.matrix3;
+    let stretch = m
+        .x_axis
+        .length()
+        .max(m.y_axis.length())
+        .max(m.z_axis.length())
+        .max(1e-300);
+    let (nu, nv) = surface.segments_for(0.25 * pixel / stretch);
+    let (nu, nv) = (nu.min(1024), nv.min(1024));
+    let grid = surface.tessellate(nu, nv);
+    let at = |i: usize, j: usize| grid[i * (nu + 1) + j];
+    for i in 0..nv {
+        for j in 0..nu {
+            for v in [
+                [at(i, j), at(i, j + 1), at(i + 1, j + 1)],
+                [at(i, j), at(i + 1, j + 1), at(i + 1, j)],
+            ] {
+                let p = v.map(|(p, _)| to_f32(t.point(p)));
+                let area = (p[1] - p[0]).cross(p[2] - p[0]);
+                if !(area.length_squared() > 0.0) || !area.is_finite() {
+                    continue; // collapsed at a pole
+                }
+                let n = v.map(|(_, n)| to_f32(t.normal(n).normalize()));
+                let normals = if n.iter().all(|n| n.is_finite()) {
+                    vertex_normals.push(n);
+                    Some(vertex_normals.len() as u32 - 1)
+                } else {
+                    None
+                };
+                primitives.push(Primitive {
+                    shape: Shape::Triangle { p, normals },
+                    material,
+                });
+            }
         }
     }
 }

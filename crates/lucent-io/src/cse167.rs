@@ -177,7 +177,18 @@ struct Command<'a> {
     end_col: u32,
 }
 
+/// A `nurbs` command waiting for its `knotsu`, `knotsv` and `cpoint` lines.
+struct PendingNurbs {
+    at: Loc,
+    line: u32,
+    transform: u32,
+    material: u32,
+    surface: lucent_core::shape::nurbs::NurbsSurface,
+}
+
 struct Parser {
+    /// The `nurbs` command being read, if any.
+    nurbs: Option<PendingNurbs>,
     /// Where files named by the scene are looked for: the scene file's directory.
     base_dir: std::path::PathBuf,
     desc: SceneDesc,
@@ -203,6 +214,7 @@ struct Parser {
 impl Parser {
     fn new(options: ParseOptions) -> Parser {
         Parser {
+            nurbs: None,
             base_dir: std::path::PathBuf::new(),
             desc: SceneDesc::default(),
             diags: Diagnostics::default(),
@@ -305,7 +317,20 @@ impl Parser {
     }
 
     fn command(&mut self, c: &Command) {
+        if self.nurbs.is_some() && !matches!(c.name.text, "knotsu" | "knotsv" | "cpoint") {
+            let p = self.nurbs.take().expect("checked");
+            let wanted = Self::nurbs_expects(&p.surface);
+            self.err_cmd(
+                c,
+                format!(
+                    "'{}' inside the nurbs surface of line {} (expected {wanted})",
+                    c.name.text, p.line
+                ),
+            );
+        }
         match c.name.text {
+            "nurbs" => self.nurbs_header(c),
+            "knotsu" | "knotsv" | "cpoint" => self.nurbs_part(c),
             "size" => self.size(c),
             "maxdepth" => {
                 if let Some([d]) = self.ints::<1>(c) {
@@ -872,6 +897,151 @@ impl Parser {
         }
     }
 
+    /// `nurbs du dv nu nv`: degrees and control point counts; the knots and control
+    /// points follow on their own lines.
+    fn nurbs_header(&mut self, c: &Command) {
+        let Some([du, dv, nu, nv]) = self.ints::<4>(c) else {
+            return;
+        };
+        for (k, d) in [(0, du), (1, dv)] {
+            if !(1..=16).contains(&d) {
+                self.err_arg(c, k, format!("nurbs: degree must be between 1 and 16, got {d}"));
+                return;
+            }
+        }
+        for (k, n, d) in [(2, nu, du), (3, nv, dv)] {
+            if n < d + 1 {
+                self.err_arg(
+                    c,
+                    k,
+                    format!("nurbs: degree {d} needs at least {} control points, got {n}", d + 1),
+                );
+                return;
+            }
+        }
+        if nu * nv > 1 << 20 {
+            self.err_span(c, 2, 2, format!("nurbs: {nu} × {nv} control points is too many"));
+            return;
+        }
+        let transform = self.transform_id();
+        let material = self.material_id();
+        self.nurbs = Some(PendingNurbs {
+            at: self.loc(c.line, &c.name),
+            line: c.line,
+            transform,
+            material,
+            surface: lucent_core::shape::nurbs::NurbsSurface {
+                degree_u: du as usize,
+                degree_v: dv as usize,
+                count_u: nu as usize,
+                count_v: nv as usize,
+                knots_u: Vec::new(),
+                knots_v: Vec::new(),
+                points: Vec::new(),
+            },
+        });
+    }
+
+    /// What the pending surface needs next.
+    fn nurbs_expects(s: &lucent_core::shape::nurbs::NurbsSurface) -> String {
+        if s.knots_u.is_empty() {
+            "knotsu".into()
+        } else if s.knots_v.is_empty() {
+            "knotsv".into()
+        } else {
+            format!("{} more cpoint lines", s.count_u * s.count_v - s.points.len())
+        }
+    }
+
+    fn nurbs_part(&mut self, c: &Command) {
+        let name = c.name.text;
+        let Some(mut p) = self.nurbs.take() else {
+            self.err_cmd(c, format!("{name}: only allowed right after a 'nurbs' command"));
+            return;
+        };
+        let expected = Self::nurbs_expects(&p.surface);
+        let fits = match name {
+            "knotsu" => p.surface.knots_u.is_empty(),
+            "knotsv" => !p.surface.knots_u.is_empty() && p.surface.knots_v.is_empty(),
+            _ => !p.surface.knots_v.is_empty(),
+        };
+        if !fits {
+            self.err_cmd(
+                c,
+                format!(
+                    "{name}: out of order in the nurbs surface of line {} (expected {expected})",
+                    p.line
+                ),
+            );
+            return;
+        }
+        let s = &mut p.surface;
+        if name == "cpoint" {
+            let Some([x, y, z, w]) = self.nums::<4>(c) else { return };
+            if !(w > 0.0) {
+                self.err_arg(c, 3, format!("cpoint: weight must be positive, got {}", c.args[3].text));
+                return;
+            }
+            s.points.push(glam::DVec4::new(x * w, y * w, z * w, w));
+        } else {
+            let (degree, count) = if name == "knotsu" {
+                (s.degree_u, s.count_u)
+            } else {
+                (s.degree_v, s.count_v)
+            };
+            let want = count + degree + 1;
+            if c.args.len() != want {
+                self.err_cmd(
+                    c,
+                    format!(
+                        "{name}: expected {want} knots ({count} control points of degree {degree}), got {}",
+                        c.args.len()
+                    ),
+                );
+                return;
+            }
+            let mut knots = Vec::with_capacity(want);
+            for (k, tok) in c.args.iter().enumerate() {
+                let Some(x) = self.number(c, tok) else { return };
+                if let Some(&prev) = knots.last() {
+                    if x < prev {
+                        self.err_arg(
+                            c,
+                            k,
+                            format!("{name}: knots must not decrease ({} after {prev})", tok.text),
+                        );
+                        return;
+                    }
+                }
+                knots.push(x);
+            }
+            if !(knots[degree] < knots[count]) {
+                self.err_cmd(
+                    c,
+                    format!("{name}: the knots leave no parameter range (knot {degree} equals knot {count})"),
+                );
+                return;
+            }
+            if name == "knotsu" {
+                s.knots_u = knots;
+            } else {
+                s.knots_v = knots;
+            }
+        }
+        if s.points.len() == s.count_u * s.count_v {
+            let index = self.desc.nurbs.len() as u32;
+            self.desc.nurbs.push(p.surface);
+            self.desc.shapes.push(ShapeDesc {
+                kind: ShapeKind::Nurbs { index },
+                transform: p.transform,
+                material: p.material,
+                loc: p.at,
+            });
+        } else {
+            self.nurbs = Some(p);
+        }
+    }
+
     fn triangle(&mut self, c: &Command) {
         let Some(idx) = self.ints::<3>(c) else { return };
         let normals = c.name.text == "trinormal";
@@ -926,10 +1096,7 @@ impl Parser {
 
     fn shape(&mut self, c: &Command, kind: ShapeKind) {
         let transform = self.transform_id();
-        let material = *self.material_id.get_or_insert_with(|| {
-            self.desc.materials.push(self.material);
-            (self.desc.materials.len() - 1) as u32
-        });
+        let material = self.material_id();
         let loc = self.loc(c.line, &c.name);
         self.desc.shapes.push(ShapeDesc {
             kind,
@@ -937,6 +1104,14 @@ impl Parser {
             material,
             loc,
         });
+    }
+
+    /// The current material's index in `desc.materials`, added there on first use.
+    fn material_id(&mut self) -> u32 {
+        *self.material_id.get_or_insert_with(|| {
+            self.desc.materials.push(self.material);
+            (self.desc.materials.len() - 1) as u32
+        })
     }
 
     fn light(&mut self, c: &Command, kind: LightKind) {
@@ -968,6 +1143,13 @@ impl Parser {
     }
 
     fn finish(&mut self, lines: u32) {
+        if let Some(p) = self.nurbs.take() {
+            let wanted = Self::nurbs_expects(&p.surface);
+            self.diags.error(
+                p.at,
+                format!("nurbs: the file ends before the surface is complete (expected {wanted})"),
+            );
+        }
         let end = Loc {
             file: self.file,
             line: lines.max(1),

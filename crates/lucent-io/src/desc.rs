@@ -88,6 +88,8 @@ pub enum ShapeKind {
     Cone { radius: f64, height: f64 },
     /// A triangle of a tessellated surface: indices into [`SceneDesc::tessellated`].
     TessellatedTri { v: [u32; 3] },
+    /// A NURBS surface: index into [`SceneDesc::nurbs`].
+    Nurbs { index: u32 },
     /// `quadric a … j x0 y0 z0 x1 y1 z1`: coefficients (not all zero) and the clip box.
     Quadric {
         coefficients: [f64; 10],
@@ -171,6 +173,9 @@ pub struct SceneDesc {
     /// Points and unit normals of tessellated surfaces (`bezierpatches`), in object space:
     /// a pile of its own, so that the `vertexnormal` numbering stays the scene's.
     pub tessellated: Vec<(DVec3, DVec3)>,
+    /// NURBS surfaces (`nurbs` with its `knotsu`, `knotsv` and `cpoint` lines), in object
+    /// space; tessellated when the scene is built, when the camera says how fine.
+    pub nurbs: Vec<lucent_core::shape::nurbs::NurbsSurface>,
     /// Transforms captured by shapes and lights (deduplicated while parsing).
     pub transforms: Vec<Transform>,
     /// Materials captured by shapes (deduplicated while parsing).

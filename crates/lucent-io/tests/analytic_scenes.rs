@@ -342,3 +342,46 @@ fn a_rotated_cylinder_in_front_of_an_infinite_plane() {
         assert!(side > 200 && floor > 1000, "{side} {floor}");
     }
 }
+
+/// The `nurbs` lines of the textbook rational quadratic sphere of radius `r`.
+fn nurbs_sphere_text(r: f64) -> String {
+    let s = lucent_core::shape::nurbs::sphere(r);
+    let mut text = String::from("nurbs 2 2 9 5\n");
+    let knots = |k: &[f64]| k.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ");
+    text += &format!("knotsu {}\nknotsv {}\n", knots(&s.knots_u), knots(&s.knots_v));
+    for p in &s.points {
+        let q = p.truncate() / p.w;
+        text += &format!("cpoint {} {} {} {}\n", q.x, q.y, q.z, p.w);
+    }
+    text
+}
+
+#[test]
+fn a_nurbs_sphere_has_the_silhouette_of_the_analytic_sphere() {
+    // White where the ray hits, black where it misses; the two pictures may differ only
+    // on pixels within one pixel of the analytic silhouette.
+    let head = "size 160 120\ncamera 0.3 -0.2 4 0 0 0 0 1 0 45\nambient 0 0 0\nemission 1 1 1\ntranslate 0.2 0.1 0\nrotate 1 1 0 40\n";
+    let analytic = render_bytes(&format!("{head}sphere 0 0 0 1.3\n"), AccelKind::Bvh, 2);
+    let nurbs = render_bytes(&format!("{head}{}", nurbs_sphere_text(1.3)), AccelKind::Bvh, 2);
+    let hit = |img: &(u32, u32, Vec<u8>), x: i64, y: i64| pixel(img, x as u32, y as u32)[0] > 128;
+    let (mut inside, mut differ) = (0, 0);
+    for y in 0..120i64 {
+        for x in 0..160i64 {
+            let a = hit(&analytic, x, y);
+            inside += a as usize;
+            if a == hit(&nurbs, x, y) {
+                continue;
+            }
+            differ += 1;
+            let near_edge = (-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    let (nx, ny) = (x + dx, y + dy);
+                    (0..160).contains(&nx) && (0..120).contains(&ny) && hit(&analytic, nx, ny) != a
+                })
+            });
+            assert!(near_edge, "pixel ({x}, {y}) differs away from the silhouette");
+        }
+    }
+    assert!(inside > 3000, "{inside}");
+    assert!(differ < 40, "{differ} pixels differ");
+}

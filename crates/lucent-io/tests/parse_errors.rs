@@ -438,3 +438,55 @@ fn the_shipped_teapot_scene_tessellates() {
     assert_eq!(desc.tessellated.len(), 32 * 17 * 17);
     assert!(desc.tessellated.iter().all(|(_, n)| (n.length() - 1.0).abs() < 1e-9));
 }
+
+#[test]
+fn nurbs_surfaces() {
+    let knots_ok = "knotsu 0 0 1 1\nknotsv 0 0 1 1\n";
+    let points = "cpoint 0 0 0 1\ncpoint 1 0 0 1\ncpoint 0 1 0 1\ncpoint 1 1 0 1\n";
+    let ok = format!("{HEADER}nurbs 1 1 2 2\n{knots_ok}{points}");
+    assert!(messages(&ok, true).is_empty(), "{:?}", messages(&ok, true));
+    for (text, msg) in [
+        (
+            "nurbs 0 1 2 2",
+            "t.test:3:7: error: nurbs: degree must be between 1 and 16, got 0",
+        ),
+        (
+            "nurbs 2 1 2 2",
+            "t.test:3:11: error: nurbs: degree 2 needs at least 3 control points, got 2",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsu 0 0 1",
+            "t.test:4:1: error: knotsu: expected 4 knots (2 control points of degree 1), got 3",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsu 0 1 0.5 1",
+            "t.test:4:12: error: knotsu: knots must not decrease (0.5 after 1)",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsu 0 1 1 1",
+            "t.test:4:1: error: knotsu: the knots leave no parameter range (knot 1 equals knot 2)",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsv 0 0 1 1",
+            "t.test:4:1: error: knotsv: out of order in the nurbs surface of line 3 (expected knotsu)",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsu 0 0 1 1\nknotsv 0 0 1 1\ncpoint 0 0 0 0",
+            "t.test:6:14: error: cpoint: weight must be positive, got 0",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsu 0 0 1 1\nsphere 0 0 0 1",
+            "t.test:5:1: error: 'sphere' inside the nurbs surface of line 3 (expected knotsv)",
+        ),
+        (
+            "nurbs 1 1 2 2\nknotsu 0 0 1 1\nknotsv 0 0 1 1\ncpoint 0 0 0 1",
+            "t.test:3:1: error: nurbs: the file ends before the surface is complete (expected 3 more cpoint lines)",
+        ),
+        (
+            "cpoint 0 0 0 1",
+            "t.test:3:1: error: cpoint: only allowed right after a 'nurbs' command",
+        ),
+    ] {
+        assert_eq!(first_error(text), msg, "{text}");
+    }
+}

@@ -71,6 +71,7 @@ pub fn run(args: &CheckArgs) -> u8 {
         ("disk", count(&|k| matches!(k, ShapeKind::Disk { .. }))),
         ("cone", count(&|k| matches!(k, ShapeKind::Cone { .. }))),
         ("quadric", count(&|k| matches!(k, ShapeKind::Quadric { .. }))),
+        ("nurbs surface", count(&|k| matches!(k, ShapeKind::Nurbs { .. }))),
         (
             "patch triangle",
             count(&|k| matches!(k, ShapeKind::TessellatedTri { .. })),

@@ -7,6 +7,7 @@ pub mod cone;
 pub mod cuboid;
 pub mod cylinder;
 pub mod disk;
+pub mod nurbs;
 pub mod plane;
 pub mod quadratic;
 pub mod quadric;
