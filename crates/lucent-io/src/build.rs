@@ -296,7 +296,8 @@ fn add_nurbs(
         .max(m.z_axis.length())
         .max(1e-300);
     let (nu, nv) = surface.segments_for(0.25 * pixel / stretch);
-    let (nu, nv) = (nu.min(1024), nv.min(1024));
+    // A bound on the triangles one surface may cost (half a million).
+    let (nu, nv) = (nu.min(512), nv.min(512));
     let grid = surface.tessellate(nu, nv);
     let at = |i: usize, j: usize| grid[i * (nu + 1) + j];
     for i in 0..nv {

@@ -147,6 +147,8 @@ impl NurbsSurface {
             } else {
                 (16 * spans_v, 8 * spans_u)
             };
+            // 16 samples per span along the direction, 8 across, within a fixed budget.
+            let (n, m) = (n.min(512), m.min(64));
             let (a0, a1, b0, b1) = if along_u { (u0, u1, v0, v1) } else { (v0, v1, u0, u1) };
             let h = (a1 - a0) / n as f64;
             let mut worst: f64 = 0.0;
