@@ -47,9 +47,8 @@ impl Scene {
             lights,
             vertex_normals,
         } = parts;
-        let bounded: Vec<u32> = crate::accel::bounded(&primitives).map(|(i, _)| i).collect();
         let unbounded = (0..primitives.len() as u32)
-            .filter(|i| bounded.binary_search(i).is_err())
+            .filter(|&i| !crate::accel::is_bounded(&primitives[i as usize].bounds()))
             .collect();
         Scene {
             width,

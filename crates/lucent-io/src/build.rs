@@ -92,16 +92,7 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
             ShapeKind::TessellatedTri { v } => {
                 let p = v.map(|i| to_f32(t.point(desc.tessellated[i as usize].0)));
                 let n = v.map(|i| to_f32(t.normal(desc.tessellated[i as usize].1).normalize()));
-                // A fully degenerate patch has no normals: shade it flat.
-                if n.iter().all(|n| n.is_finite()) {
-                    vertex_normals.push(n);
-                    Shape::Triangle {
-                        p,
-                        normals: Some(vertex_normals.len() as u32 - 1),
-                    }
-                } else {
-                    Shape::Triangle { p, normals: None }
-                }
+                smooth_triangle(p, n, &mut vertex_normals)
             }
             ShapeKind::TriNormal { v } => {
                 let p = v.map(|i| to_f32(t.point(desc.vertex_normals[i as usize].0)));
@@ -299,30 +290,31 @@ fn add_nurbs(
     // A bound on the triangles one surface may cost (half a million).
     let (nu, nv) = (nu.min(512), nv.min(512));
     let grid = surface.tessellate(nu, nv);
-    let at = |i: usize, j: usize| grid[i * (nu + 1) + j];
-    for i in 0..nv {
-        for j in 0..nu {
-            for v in [
-                [at(i, j), at(i, j + 1), at(i + 1, j + 1)],
-                [at(i, j), at(i + 1, j + 1), at(i + 1, j)],
-            ] {
-                let p = v.map(|(p, _)| to_f32(t.point(p)));
-                let area = (p[1] - p[0]).cross(p[2] - p[0]);
-                if !(area.length_squared() > 0.0) || !area.is_finite() {
-                    continue; // collapsed at a pole
-                }
-                let n = v.map(|(_, n)| to_f32(t.normal(n).normalize()));
-                let normals = if n.iter().all(|n| n.is_finite()) {
-                    vertex_normals.push(n);
-                    Some(vertex_normals.len() as u32 - 1)
-                } else {
-                    None
-                };
-                primitives.push(Primitive {
-                    shape: Shape::Triangle { p, normals },
-                    material,
-                });
-            }
+    for tri in lucent_core::shape::parametric::grid_triangles(nu, nv) {
+        let v = tri.map(|k| grid[k]);
+        let p = v.map(|(p, _)| to_f32(t.point(p)));
+        let area = (p[1] - p[0]).cross(p[2] - p[0]);
+        if !(area.length_squared() > 0.0) || !area.is_finite() {
+            continue; // collapsed at a pole
         }
+        let n = v.map(|(_, n)| to_f32(t.normal(n).normalize()));
+        primitives.push(Primitive {
+            shape: smooth_triangle(p, n, vertex_normals),
+            material,
+        });
+    }
+}
+
+/// A triangle of a tessellated surface with its vertex normals; shaded flat where the
+/// surface had none (a fully degenerate patch gives non-finite normals).
+fn smooth_triangle(p: [Vec3A; 3], n: [Vec3A; 3], vertex_normals: &mut Vec<[Vec3A; 3]>) -> Shape {
+    if n.iter().all(|n| n.is_finite()) {
+        vertex_normals.push(n);
+        Shape::Triangle {
+            p,
+            normals: Some(vertex_normals.len() as u32 - 1),
+        }
+    } else {
+        Shape::Triangle { p, normals: None }
     }
 }

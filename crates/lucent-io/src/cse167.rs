@@ -9,6 +9,8 @@
 
 use std::path::Path;
 
+use lucent_core::shape::parametric::grid_triangles;
+
 use glam::DVec3;
 use lucent_core::camera::{Camera, CameraError};
 use lucent_core::transform::Transform;
@@ -879,19 +881,12 @@ impl Parser {
             self.desc
                 .tessellated
                 .extend(lucent_core::shape::bezier::tessellate(patch, divisions));
-            let at = |i: usize, j: usize| base + (i * n + j) as u32;
-            for i in 0..n - 1 {
-                for j in 0..n - 1 {
-                    for v in [
-                        [at(i, j), at(i, j + 1), at(i + 1, j + 1)],
-                        [at(i, j), at(i + 1, j + 1), at(i + 1, j)],
-                    ] {
-                        // Quads at a pole have a collapsed edge: drop their empty triangles.
-                        let p = v.map(|k| self.desc.tessellated[k as usize].0);
-                        if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 0.0 {
-                            self.shape(c, ShapeKind::TessellatedTri { v });
-                        }
-                    }
+            for tri in grid_triangles(n - 1, n - 1) {
+                let v = tri.map(|k| base + k as u32);
+                // Quads at a pole have a collapsed edge: drop their empty triangles.
+                let p = v.map(|k| self.desc.tessellated[k as usize].0);
+                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 0.0 {
+                    self.shape(c, ShapeKind::TessellatedTri { v });
                 }
             }
         }

@@ -41,8 +41,13 @@ pub fn search_limit(t: f32) -> f32 {
 pub fn bounded(prims: &[Primitive]) -> impl Iterator<Item = (u32, Aabb)> + '_ {
     prims.iter().enumerate().filter_map(|(i, p)| {
         let b = p.bounds();
-        (b.min.is_finite() && b.max.is_finite()).then_some((i as u32, b))
+        is_bounded(&b).then_some((i as u32, b))
     })
+}
+
+/// Whether a primitive with these bounds belongs in a structure (see [`bounded`]).
+pub fn is_bounded(b: &Aabb) -> bool {
+    b.min.is_finite() && b.max.is_finite()
 }
 
 pub trait Accelerator: Send + Sync {

@@ -43,16 +43,11 @@ pub fn evaluate(p: &[DVec3; 16], u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
 /// The unit normal `∂S/∂u × ∂S/∂v` at `(u, v)`, or where it vanishes, the normal a
 /// little way towards the middle of the patch; `None` if the whole patch is degenerate.
 pub fn normal(p: &[DVec3; 16], u: f64, v: f64) -> Option<DVec3> {
-    for step in [0.0, 1e-4, 1e-3, 1e-2] {
-        let (uu, vv) = (u + (0.5 - u) * step, v + (0.5 - v) * step);
-        let (_, su, sv) = evaluate(p, uu, vv);
-        let n = su.cross(sv);
-        let scale = su.length_squared().max(sv.length_squared());
-        if n.length_squared() > 1e-20 * scale * scale && n.is_finite() {
-            return Some(n.normalize());
-        }
-    }
-    None
+    let derivatives = |u, v| {
+        let (_, su, sv) = evaluate(p, u, v);
+        (su, sv)
+    };
+    super::parametric::normal(derivatives, (u, v), (0.5, 0.5))
 }
 
 /// `(divisions + 1)²` points and normals on a regular `(u, v)` grid, row by row in `v`.

@@ -8,6 +8,7 @@ pub mod cuboid;
 pub mod cylinder;
 pub mod disk;
 pub mod nurbs;
+pub mod parametric;
 pub mod plane;
 pub mod quadratic;
 pub mod quadric;

@@ -120,17 +120,11 @@ impl NurbsSurface {
     /// The unit normal `S_u × S_v`, taken a little way inside where it vanishes (poles).
     pub fn normal(&self, u: f64, v: f64) -> Option<DVec3> {
         let ((u0, u1), (v0, v1)) = self.domain();
-        let (um, vm) = ((u0 + u1) / 2.0, (v0 + v1) / 2.0);
-        for step in [0.0, 1e-5, 1e-4, 1e-3, 1e-2] {
-            let (uu, vv) = (u + (um - u) * step, v + (vm - v) * step);
-            let (_, a, b) = self.evaluate(uu, vv);
-            let n = a.cross(b);
-            let scale = a.length_squared().max(b.length_squared());
-            if n.length_squared() > 1e-20 * scale * scale && n.is_finite() {
-                return Some(n.normalize());
-            }
-        }
-        None
+        let derivatives = |u, v| {
+            let (_, su, sv) = self.evaluate(u, v);
+            (su, sv)
+        };
+        super::parametric::normal(derivatives, (u, v), ((u0 + u1) / 2.0, (v0 + v1) / 2.0))
     }
 
     /// Segments along u and v so that no chord strays more than `tolerance` from the
