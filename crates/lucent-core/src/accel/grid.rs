@@ -122,10 +122,6 @@ impl Grid {
             }
         }
     }
-
-    pub fn resolution(&self) -> [usize; 3] {
-        self.res
-    }
 }
 
 impl CellWalk for Grid {

@@ -82,10 +82,6 @@ impl KdTree {
             prim_count: prims.len(),
         }
     }
-
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
-    }
 }
 
 impl Builder<'_> {
@@ -209,8 +205,6 @@ fn best_plane(node_box: &Aabb, items: &[Item]) -> Option<(usize, f32)> {
     let (cost, axis, pos) = best?;
     (cost < INTERSECTION_COST * n as f32).then_some((axis, pos))
 }
-
-impl KdTree {}
 
 impl CellWalk for KdTree {
     #[inline(always)]

@@ -134,10 +134,6 @@ impl Octree {
             prim_count: prims.len(),
         }
     }
-
-    pub fn node_count(&self) -> usize {
-        self.nodes.len()
-    }
 }
 
 impl CellWalk for Octree {

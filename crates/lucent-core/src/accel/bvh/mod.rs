@@ -79,10 +79,6 @@ impl Bvh {
         self.nodes.len()
     }
 
-    pub fn isa(&self) -> Isa {
-        self.isa
-    }
-
     /// Every primitive index the leaves hold, in leaf order.
     #[cfg(test)]
     fn leaf_prims(&self) -> Vec<u32> {
