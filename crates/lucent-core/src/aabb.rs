@@ -27,6 +27,31 @@ impl Aabb {
         points.iter().fold(Aabb::EMPTY, |b, &p| b.grow(p))
     }
 
+    /// A box holding this one after `m`: the bounds of its eight transformed corners,
+    /// widened by a few units in the last place so that rounding in the transform (of
+    /// the box or of a ray) cannot put a surface point outside it. Empty stays empty.
+    pub fn transformed(&self, m: &crate::math::Affine3A) -> Aabb {
+        if self.is_empty() {
+            return Aabb::EMPTY;
+        }
+        let corners: Vec<Vec3A> = (0..8)
+            .map(|i| {
+                let c = Vec3A::new(
+                    if i & 1 == 0 { self.min.x } else { self.max.x },
+                    if i & 2 == 0 { self.min.y } else { self.max.y },
+                    if i & 4 == 0 { self.min.z } else { self.max.z },
+                );
+                m.transform_point3a(c)
+            })
+            .collect();
+        let b = Aabb::from_points(&corners);
+        let pad = 1e-6 * (b.extent().max_element() + b.min.abs().max(b.max.abs()).max_element());
+        Aabb {
+            min: b.min - Vec3A::splat(pad),
+            max: b.max + Vec3A::splat(pad),
+        }
+    }
+
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }

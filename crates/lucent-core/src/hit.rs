@@ -12,9 +12,49 @@ pub struct Hit {
     /// Barycentric weights of the second and third triangle vertex (0 for other shapes).
     pub b1: f32,
     pub b2: f32,
+    /// Where inside `prim` the hit lies, for primitives made of others: the triangle of a
+    /// mesh, or the primitive of an instanced object and then (if that is a mesh) its
+    /// triangle. Unused levels are [`Hit::NONE`].
+    pub inner: [u32; 2],
 }
 
 impl Hit {
+    /// An unused level of [`Hit::inner`].
+    pub const NONE: u32 = u32::MAX;
+
+    /// A hit on a simple primitive (nothing inside it).
+    #[inline(always)]
+    pub fn new(t: f32, prim: u32, b1: f32, b2: f32) -> Hit {
+        Hit {
+            t,
+            prim,
+            b1,
+            b2,
+            inner: [Hit::NONE; 2],
+        }
+    }
+
+    /// This hit seen from one level up: it lies inside primitive `outer`.
+    #[inline(always)]
+    pub fn within(self, outer: u32) -> Hit {
+        debug_assert!(self.inner[1] == Hit::NONE, "hits nest at most three levels deep");
+        Hit {
+            prim: outer,
+            inner: [self.prim, self.inner[0]],
+            ..self
+        }
+    }
+
+    /// The hit one level down, as the primitive containing it sees it.
+    #[inline(always)]
+    pub fn inside(self) -> Hit {
+        Hit {
+            prim: self.inner[0],
+            inner: [self.inner[1], Hit::NONE],
+            ..self
+        }
+    }
+
     /// The tie-breaking rule every acceleration structure shares, so that all of them
     /// return the same hit as the brute-force list: the smaller `t` wins, and for equal
     /// `t` the primitive that comes first in the scene.

@@ -1,9 +1,13 @@
 //! The primitives a scene holds: what the acceleration structures bound and intersect,
 //! and what turns a hit into a surface point for shading.
 
+use std::sync::Arc;
+
 use crate::aabb::Aabb;
 use crate::hit::{Hit, SurfacePoint};
+use crate::instance::Instance;
 use crate::math::{Affine3A, Mat3A, Vec3A};
+use crate::mesh::MeshShape;
 use crate::ray::PreparedRay;
 use crate::shape::{cone, cuboid, cylinder, disk, plane, quadric, sphere, texcoord, triangle};
 use glam::Vec2;
@@ -131,18 +135,7 @@ impl Analytic {
     pub fn new(object_to_world: Affine3A, kind: AnalyticKind) -> Analytic {
         let world_to_object = object_to_world.inverse();
         let bounds = match kind.object_bounds() {
-            Some(b) => Aabb::from_points(
-                &(0..8)
-                    .map(|i| {
-                        let corner = Vec3A::new(
-                            if i & 1 == 0 { b.min.x } else { b.max.x },
-                            if i & 2 == 0 { b.min.y } else { b.max.y },
-                            if i & 4 == 0 { b.min.z } else { b.max.z },
-                        );
-                        object_to_world.transform_point3a(corner)
-                    })
-                    .collect::<Vec<_>>(),
-            ),
+            Some(b) => b.transformed(&object_to_world),
             None => Aabb {
                 min: Vec3A::NEG_INFINITY,
                 max: Vec3A::INFINITY,
@@ -166,8 +159,12 @@ pub enum Shape {
         normals: Option<u32>,
     },
     Sphere(Sphere),
-    /// Boxed: it is much larger than a triangle, and meshes should not pay for it.
+    /// Boxed: it is much larger than a triangle, and triangles should not pay for it.
     Analytic(Box<Analytic>),
+    /// A whole triangle mesh (with its own structure), possibly shared.
+    Mesh(Arc<MeshShape>),
+    /// An object placed by `instance`.
+    Instance(Box<Instance>),
 }
 
 #[derive(Clone, Debug)]
@@ -182,30 +179,73 @@ impl Primitive {
             Shape::Triangle { p, .. } => Aabb::from_points(p),
             Shape::Sphere(s) => s.bounds,
             Shape::Analytic(a) => a.bounds,
+            Shape::Mesh(m) => m.bounds(),
+            Shape::Instance(i) => i.bounds,
         }
     }
 
-    /// The hit of `ray` with this primitive in `(t_min, t_max]`, as
-    /// `(t, b1, b2)` (barycentrics are 0 for spheres).
-    #[inline(always)]
-    pub fn intersect(&self, ray: &PreparedRay, t_max: f32) -> Option<(f32, f32, f32)> {
+    /// How many simple primitives this one stands for (see
+    /// [`crate::geometry::Geometry::shown_primitive_count`]).
+    pub fn shown_count(&self) -> u64 {
         match &self.shape {
-            Shape::Triangle { p, .. } => triangle::intersect(ray, p[0], p[1], p[2], t_max).map(|h| (h.t, h.b1, h.b2)),
+            Shape::Mesh(m) => m.mesh.indices.len() as u64,
+            Shape::Instance(i) => i.object.shown_primitive_count(),
+            _ => 1,
+        }
+    }
+
+    /// The corners, if this is a plain triangle.
+    #[inline]
+    pub fn triangle(&self) -> Option<[Vec3A; 3]> {
+        match &self.shape {
+            Shape::Triangle { p, .. } => Some(*p),
+            _ => None,
+        }
+    }
+
+    /// Whether anything of this primitive lies in `(ray.t_min, t_max]` (shadow rays:
+    /// any hit will do, which is cheaper than the closest for meshes and instances).
+    #[inline(always)]
+    pub fn occludes(&self, ray: &PreparedRay, t_max: f32) -> bool {
+        match &self.shape {
+            Shape::Mesh(m) => m.occludes(ray, t_max),
+            Shape::Instance(i) => i.occludes(ray, t_max),
+            _ => self.intersect(0, ray, t_max).is_some(),
+        }
+    }
+
+    /// The hit of `ray` with this primitive in `(t_min, t_max]`, reported as primitive
+    /// `index` (barycentrics are 0 for shapes other than triangles).
+    #[inline(always)]
+    pub fn intersect(&self, index: u32, ray: &PreparedRay, t_max: f32) -> Option<Hit> {
+        match &self.shape {
+            Shape::Triangle { p, .. } => {
+                triangle::intersect(ray, p[0], p[1], p[2], t_max).map(|h| Hit::new(h.t, index, h.b1, h.b2))
+            }
             Shape::Sphere(s) => {
                 let o = s.world_to_object.transform_point3a(ray.ray.origin);
                 let d = s.world_to_object.transform_vector3a(ray.ray.dir);
-                sphere::intersect_unit_geometric(o, d, ray.ray.t_min, t_max).map(|t| (t, 0.0, 0.0))
+                sphere::intersect_unit_geometric(o, d, ray.ray.t_min, t_max).map(|t| Hit::new(t, index, 0.0, 0.0))
             }
             Shape::Analytic(a) => {
                 let o = a.world_to_object.transform_point3a(ray.ray.origin);
                 let d = a.world_to_object.transform_vector3a(ray.ray.dir);
-                a.kind.intersect(o, d, ray.ray.t_min, t_max).map(|t| (t, 0.0, 0.0))
+                a.kind
+                    .intersect(o, d, ray.ray.t_min, t_max)
+                    .map(|t| Hit::new(t, index, 0.0, 0.0))
             }
+            Shape::Mesh(m) => m.intersect(ray, t_max).map(|h| h.within(index)),
+            Shape::Instance(i) => i.intersect(ray, t_max).map(|h| h.within(index)),
         }
     }
 
     /// Shading data at a hit of `origin + t·dir` on this primitive.
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A, vertex_normals: &[[Vec3A; 3]]) -> SurfacePoint {
+        match &self.shape {
+            Shape::Mesh(m) => return m.mesh.surface_point(&hit.inside(), origin, dir),
+            Shape::Instance(i) => return i.surface_point(&hit.inside(), origin, dir),
+            _ => {}
+        }
         let point = origin + dir * hit.t;
         let barycentric = Vec2::new(hit.b1, hit.b2);
         let (normal, uv) = match &self.shape {
@@ -229,6 +269,7 @@ impl Primitive {
                 let n = a.kind.normal(p);
                 ((a.normal_to_world * n).normalize(), a.kind.uv(p, n))
             }
+            Shape::Mesh(_) | Shape::Instance(_) => unreachable!("handled above"),
         };
         SurfacePoint {
             point,
@@ -257,14 +298,9 @@ mod tests {
         };
         // A ray down the z axis at (x=0.5, y=0) hits the ellipsoid x² + (y/2)² + z² = 1 at z = sqrt(0.75).
         let ray = Ray::segment(Vec3A::new(0.5, 0.0, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY);
-        let (t, _, _) = prim.intersect(&PreparedRay::new(ray), f32::INFINITY).unwrap();
+        let t = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY).unwrap().t;
         assert!((t - (5.0 - 0.75f32.sqrt())).abs() < 1e-5);
-        let hit = Hit {
-            t,
-            prim: 0,
-            b1: 0.0,
-            b2: 0.0,
-        };
+        let hit = Hit::new(t, 0, 0.0, 0.0);
         let sp = prim.surface_point(&hit, ray.origin, ray.dir, &[]);
         // Gradient of x² + y²/4 + z² is (2x, y/2, 2z) ∝ (x, y/4, z).
         let expect = Vec3A::new(0.5, 0.0, 0.75f32.sqrt()).normalize();
@@ -290,20 +326,15 @@ mod tests {
             ))),
             material: 0,
         };
-        // World bounds: x 4..6, y 0..2, z −1..1.
+        // World bounds: x 4..6, y 0..2, z −1..1, widened by a few units in the last place.
         let b = prim.bounds();
-        assert!(
-            (b.min - Vec3A::new(4.0, 0.0, -1.0)).length() < 1e-5 && (b.max - Vec3A::new(6.0, 2.0, 1.0)).length() < 1e-5
-        );
+        let (lo, hi) = (Vec3A::new(4.0, 0.0, -1.0), Vec3A::new(6.0, 2.0, 1.0));
+        assert!(b.min.cmple(lo).all() && b.max.cmpge(hi).all());
+        assert!((b.min - lo).length() < 1e-4 && (b.max - hi).length() < 1e-4);
         let ray = Ray::segment(Vec3A::new(5.0, 1.5, 10.0), -Vec3A::Z, 1e-4, f32::INFINITY);
-        let (t, _, _) = prim.intersect(&PreparedRay::new(ray), f32::INFINITY).unwrap();
+        let t = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY).unwrap().t;
         assert!((t - 9.0).abs() < 1e-5, "{t}");
-        let hit = Hit {
-            t,
-            prim: 0,
-            b1: 0.0,
-            b2: 0.0,
-        };
+        let hit = Hit::new(t, 0, 0.0, 0.0);
         let sp = prim.surface_point(&hit, ray.origin, ray.dir, &[]);
         assert!((sp.normal - Vec3A::Z).length() < 1e-5, "{}", sp.normal);
         assert!((sp.uv - glam::Vec2::new(0.75, 0.75)).length() < 1e-5, "{}", sp.uv);

@@ -1,28 +1,24 @@
 //! A scene ready to render: primitives with their acceleration structure, materials,
 //! lights, the camera and the global settings.
 
-use crate::accel::{AccelKind, Accelerator};
+use crate::accel::AccelKind;
 use crate::camera::Camera;
+use crate::geometry::Geometry;
 use crate::hit::{Hit, SurfacePoint};
 use crate::light::Light;
 use crate::material::Material;
 use crate::math::Vec3A;
 use crate::primitive::Primitive;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::Ray;
 
 pub struct Scene {
     pub width: u32,
     pub height: u32,
     pub camera: Camera,
-    pub primitives: Vec<Primitive>,
+    pub geometry: Geometry,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
-    /// Per-vertex normals of `trinormal` triangles, indexed by `Shape::Triangle::normals`.
-    pub vertex_normals: Vec<[Vec3A; 3]>,
-    accel: Box<dyn Accelerator>,
     accel_kind: AccelKind,
-    /// Primitives without finite bounds (planes), tested by every ray outside `accel`.
-    unbounded: Vec<u32>,
 }
 
 /// Everything a [`Scene`] is made of, before its acceleration structure is built.
@@ -47,66 +43,38 @@ impl Scene {
             lights,
             vertex_normals,
         } = parts;
-        let unbounded = (0..primitives.len() as u32)
-            .filter(|&i| !crate::accel::is_bounded(&primitives[i as usize].bounds()))
-            .collect();
         Scene {
             width,
             height,
             camera,
-            unbounded,
-            accel: accel.build(&primitives),
+            geometry: Geometry::new(primitives, vertex_normals, accel),
             accel_kind: accel,
-            primitives,
             materials,
             lights,
-            vertex_normals,
         }
     }
 
     #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        let mut best = self.accel.closest_hit(&self.primitives, ray);
-        if !self.unbounded.is_empty() {
-            let r = PreparedRay::new(*ray);
-            for &i in &self.unbounded {
-                let t_max = best.map_or(ray.t_max, |b| b.t);
-                if let Some((t, b1, b2)) = self.primitives[i as usize].intersect(&r, t_max) {
-                    // The same tie rule as inside the structures: scene order.
-                    if Hit::is_closer_than(t, i, &best) {
-                        best = Some(Hit { t, prim: i, b1, b2 });
-                    }
-                }
-            }
-        }
-        best
+        self.geometry.closest_hit(ray)
     }
 
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if !self.unbounded.is_empty() {
-            let r = PreparedRay::new(*ray);
-            if self
-                .unbounded
-                .iter()
-                .any(|&i| self.primitives[i as usize].intersect(&r, ray.t_max).is_some())
-            {
-                return true;
-            }
-        }
-        self.accel.occluded(&self.primitives, ray)
+        self.geometry.occluded(ray)
     }
 
     pub fn surface_point(&self, hit: &Hit, ray: &Ray) -> SurfacePoint {
-        self.primitives[hit.prim as usize].surface_point(hit, ray.origin, ray.dir, &self.vertex_normals)
+        self.geometry.surface_point(hit, ray.origin, ray.dir)
     }
 
     pub fn accel_kind(&self) -> AccelKind {
         self.accel_kind
     }
 
+    /// Bytes of the scene-level structure (not those inside meshes and objects).
     pub fn accel_memory_bytes(&self) -> usize {
-        self.accel.memory_bytes()
+        self.geometry.accel_memory_bytes()
     }
 }
 
@@ -115,6 +83,7 @@ mod tests {
     use super::*;
     use crate::accel::test_scenes::{analytic_soup, Rng};
     use crate::math::DVec3;
+    use crate::ray::PreparedRay;
 
     fn scene_of(primitives: Vec<Primitive>, accel: AccelKind) -> Scene {
         let camera = Camera::look_at(DVec3::Z, DVec3::ZERO, DVec3::Y, 45.0, 4, 4).unwrap();
@@ -149,14 +118,9 @@ mod tests {
                 let r = PreparedRay::new(*ray);
                 let mut best: Option<Hit> = None;
                 for (i, p) in prims.iter().enumerate() {
-                    if let Some((t, b1, b2)) = p.intersect(&r, best.map_or(ray.t_max, |b| b.t)) {
-                        if Hit::is_closer_than(t, i as u32, &best) {
-                            best = Some(Hit {
-                                t,
-                                prim: i as u32,
-                                b1,
-                                b2,
-                            });
+                    if let Some(hit) = p.intersect(i as u32, &r, best.map_or(ray.t_max, |b| b.t)) {
+                        if Hit::is_closer_than(hit.t, i as u32, &best) {
+                            best = Some(hit);
                         }
                     }
                 }

@@ -86,7 +86,10 @@ pub fn run(args: &CheckArgs) -> u8 {
         tris + trinormals,
         others.concat()
     );
-    println!("primitives: {} after build", built.scene.primitives.len());
+    println!(
+        "primitives: {} after build",
+        built.scene.geometry.shown_primitive_count()
+    );
     println!(
         "lights:     {} point, {} directional, {} quad",
         lights(&|k| matches!(k, LightKind::Point { .. })),

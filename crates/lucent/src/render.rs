@@ -116,7 +116,7 @@ pub fn run(args: &RenderArgs) -> u8 {
             "{}x{}, {} primitives, {} rays, {:.3} s, {:.2} Mrays/s -> {}",
             scene.width,
             scene.height,
-            scene.primitives.len(),
+            scene.geometry.shown_primitive_count(),
             stats.rays,
             render_s,
             stats.rays as f64 / render_s.max(1e-9) / 1e6,

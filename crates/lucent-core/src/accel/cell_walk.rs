@@ -5,9 +5,8 @@
 //! with the scene-order tie rule, and stop once it lies before the next cell.
 
 use super::mailbox::Mailbox;
-use super::search_limit;
+use super::{search_limit, PrimitiveSet};
 use crate::hit::Hit;
-use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 
 pub trait CellWalk {
@@ -18,7 +17,7 @@ pub trait CellWalk {
     fn prim_count(&self) -> usize;
 }
 
-pub fn closest_hit(w: &impl CellWalk, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+pub fn closest_hit<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, ray: &Ray) -> Option<Hit> {
     let r = PreparedRay::new(*ray);
     let mut best: Option<Hit> = None;
     let mut t_max = ray.t_max;
@@ -28,10 +27,10 @@ pub fn closest_hit(w: &impl CellWalk, prims: &[Primitive], ray: &Ray) -> Option<
                 if !mailbox.first_visit(pi) {
                     continue;
                 }
-                if let Some((t, b1, b2)) = prims[pi as usize].intersect(&r, t_max) {
-                    if Hit::is_closer_than(t, pi, &best) {
-                        best = Some(Hit { t, prim: pi, b1, b2 });
-                        t_max = t;
+                if let Some(hit) = prims.intersect(pi, &r, t_max) {
+                    if Hit::is_closer_than(hit.t, pi, &best) {
+                        best = Some(hit);
+                        t_max = hit.t;
                     }
                 }
             }
@@ -41,14 +40,14 @@ pub fn closest_hit(w: &impl CellWalk, prims: &[Primitive], ray: &Ray) -> Option<
     best
 }
 
-pub fn occluded(w: &impl CellWalk, prims: &[Primitive], ray: &Ray) -> bool {
+pub fn occluded<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, ray: &Ray) -> bool {
     let r = PreparedRay::new(*ray);
     let mut hit = false;
     Mailbox::with(w.prim_count(), |mailbox| {
         w.walk(ray, |ids| {
             hit = ids
                 .iter()
-                .any(|&pi| mailbox.first_visit(pi) && prims[pi as usize].intersect(&r, ray.t_max).is_some());
+                .any(|&pi| mailbox.first_visit(pi) && prims.occludes(pi, &r, ray.t_max));
             (!hit).then_some(f32::INFINITY)
         })
     });

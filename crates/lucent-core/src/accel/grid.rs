@@ -13,11 +13,10 @@
 
 use super::cell_walk::{self, CellWalk};
 use super::overlap::{cell_padding, overlaps, padded};
-use super::{search_limit, Accelerator};
+use super::{search_limit, Accelerator, PrimitiveSet};
 use crate::aabb::Aabb;
 use crate::hit::Hit;
 use crate::math::Vec3A;
-use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 
 /// Cells per primitive.
@@ -35,7 +34,7 @@ pub struct Grid {
 }
 
 impl Grid {
-    pub fn build(prims: &[Primitive]) -> Grid {
+    pub fn build<P: PrimitiveSet + ?Sized>(prims: &P) -> Grid {
         let items: Vec<(u32, Aabb)> = super::bounded(prims).collect();
         let scene = items.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b));
         if items.is_empty() {
@@ -62,7 +61,7 @@ impl Grid {
             cell_size,
             cell_start: Vec::new(),
             prim_ids: Vec::new(),
-            prim_count: prims.len(),
+            prim_count: prims.count(),
         };
         // Two passes: count the entries of every cell, then fill them in.
         let cells = res[0] * res[1] * res[2];
@@ -103,9 +102,14 @@ impl Grid {
     }
 
     /// Calls `f(cell, prim)` for every cell every primitive overlaps.
-    fn for_each_entry(&self, prims: &[Primitive], items: &[(u32, Aabb)], pad: f32, mut f: impl FnMut(usize, u32)) {
+    fn for_each_entry<P: PrimitiveSet + ?Sized>(
+        &self,
+        prims: &P,
+        items: &[(u32, Aabb)],
+        pad: f32,
+        mut f: impl FnMut(usize, u32),
+    ) {
         for &(i, bounds) in items {
-            let prim = &prims[i as usize];
             let b = padded(&bounds, pad);
             let lo = [0, 1, 2].map(|a| self.cell_of(b.min, a));
             let hi = [0, 1, 2].map(|a| self.cell_of(b.max, a));
@@ -114,7 +118,7 @@ impl Grid {
                 for y in lo[1]..=hi[1] {
                     for x in lo[0]..=hi[0] {
                         let c = [x, y, z];
-                        if single || overlaps(prim, &padded(&self.cell_box(c), pad)) {
+                        if single || overlaps(prims, i, &padded(&self.cell_box(c), pad)) {
                             f(self.index(c), i);
                         }
                     }
@@ -183,12 +187,12 @@ impl CellWalk for Grid {
     }
 }
 
-impl Accelerator for Grid {
-    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Grid {
+    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
         cell_walk::closest_hit(self, prims, ray)
     }
 
-    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
         cell_walk::occluded(self, prims, ray)
     }
 

@@ -16,10 +16,9 @@
 
 use super::cell_walk::{self, CellWalk};
 use super::overlap::{cell_padding, clipped_bounds, overlaps, padded};
-use super::{search_limit, Accelerator};
+use super::{search_limit, Accelerator, PrimitiveSet};
 use crate::aabb::Aabb;
 use crate::hit::Hit;
-use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 
 const BINS: usize = 32;
@@ -52,8 +51,8 @@ struct Item {
     b: Aabb,
 }
 
-struct Builder<'a> {
-    prims: &'a [Primitive],
+struct Builder<'a, P: ?Sized> {
+    prims: &'a P,
     pad: f32,
     max_depth: usize,
     nodes: Vec<KdNode>,
@@ -61,7 +60,7 @@ struct Builder<'a> {
 }
 
 impl KdTree {
-    pub fn build(prims: &[Primitive]) -> KdTree {
+    pub fn build<P: PrimitiveSet + ?Sized>(prims: &P) -> KdTree {
         let items: Vec<Item> = super::bounded(prims).map(|(prim, b)| Item { prim, b }).collect();
         let bounds = items.iter().fold(Aabb::EMPTY, |acc, it| acc.union(&it.b));
         let count = items.len();
@@ -79,12 +78,12 @@ impl KdTree {
             nodes: builder.nodes,
             prim_ids: builder.prim_ids,
             bounds,
-            prim_count: prims.len(),
+            prim_count: prims.count(),
         }
     }
 }
 
-impl Builder<'_> {
+impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
     fn leaf(&mut self, items: &[Item]) {
         self.nodes.push(KdNode {
             a: items.len() as u32,
@@ -140,12 +139,11 @@ impl Builder<'_> {
             } else if it.b.min[axis] > pos + self.pad {
                 hi.push(it);
             } else {
-                let prim = &self.prims[it.prim as usize];
                 for (side, padded_side, out) in [(below, &pb, &mut lo), (above, &pa, &mut hi)] {
-                    if overlaps(prim, padded_side) {
+                    if overlaps(self.prims, it.prim, padded_side) {
                         // Bounds for pricing planes further down; a sliver lost to clipping
                         // rounding keeps the plane position as a degenerate box.
-                        let b = clipped_bounds(prim, side).unwrap_or_else(|| {
+                        let b = clipped_bounds(self.prims, it.prim, side).unwrap_or_else(|| {
                             let mut flat = it.b;
                             flat.min[axis] = pos;
                             flat.max[axis] = pos;
@@ -267,12 +265,12 @@ impl CellWalk for KdTree {
     }
 }
 
-impl Accelerator for KdTree {
-    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+impl<P: PrimitiveSet + ?Sized> Accelerator<P> for KdTree {
+    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
         cell_walk::closest_hit(self, prims, ray)
     }
 
-    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
         cell_walk::occluded(self, prims, ray)
     }
 

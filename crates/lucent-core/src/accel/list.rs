@@ -1,9 +1,8 @@
 //! The brute-force list: every ray tests every primitive. The reference that every
 //! other structure is checked against (`--accel list`).
 
-use super::Accelerator;
+use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
-use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 
 pub struct PrimitiveList {
@@ -12,33 +11,31 @@ pub struct PrimitiveList {
 }
 
 impl PrimitiveList {
-    pub fn new(prims: &[Primitive]) -> PrimitiveList {
+    pub fn new<P: PrimitiveSet + ?Sized>(prims: &P) -> PrimitiveList {
         PrimitiveList {
             indices: super::bounded(prims).map(|(i, _)| i).collect(),
         }
     }
 }
 
-impl Accelerator for PrimitiveList {
-    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+impl<P: PrimitiveSet + ?Sized> Accelerator<P> for PrimitiveList {
+    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
         let r = PreparedRay::new(*ray);
         let mut best: Option<Hit> = None;
         for &i in &self.indices {
             let t_max = best.map_or(ray.t_max, |b| b.t);
-            if let Some((t, b1, b2)) = prims[i as usize].intersect(&r, t_max) {
-                if Hit::is_closer_than(t, i, &best) {
-                    best = Some(Hit { t, prim: i, b1, b2 });
+            if let Some(hit) = prims.intersect(i, &r, t_max) {
+                if Hit::is_closer_than(hit.t, i, &best) {
+                    best = Some(hit);
                 }
             }
         }
         best
     }
 
-    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
         let r = PreparedRay::new(*ray);
-        self.indices
-            .iter()
-            .any(|&i| prims[i as usize].intersect(&r, ray.t_max).is_some())
+        self.indices.iter().any(|&i| prims.occludes(i, &r, ray.t_max))
     }
 
     fn memory_bytes(&self) -> usize {

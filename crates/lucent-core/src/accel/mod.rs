@@ -19,8 +19,9 @@ mod tests;
 
 use crate::aabb::Aabb;
 use crate::hit::Hit;
+use crate::math::Vec3A;
 use crate::primitive::Primitive;
-use crate::ray::Ray;
+use crate::ray::{PreparedRay, Ray};
 
 /// How far past the closest hit so far a structure keeps looking.
 ///
@@ -35,13 +36,56 @@ pub fn search_limit(t: f32) -> f32 {
     t * (1.0 + 1.0 / 4096.0)
 }
 
-/// The primitives a structure holds: every one with finite bounds, as `(scene index,
-/// bounds)`. Unbounded ones (planes) are tested by the scene itself, outside any
-/// structure ([`crate::scene::Scene`]).
-pub fn bounded(prims: &[Primitive]) -> impl Iterator<Item = (u32, Aabb)> + '_ {
-    prims.iter().enumerate().filter_map(|(i, p)| {
-        let b = p.bounds();
-        is_bounded(&b).then_some((i as u32, b))
+/// What a structure is built over: the primitives of a scene or of an instanced object
+/// (`[Primitive]`), or the triangles of one mesh ([`crate::mesh::TriangleMesh`]), each
+/// known by its index.
+pub trait PrimitiveSet: Sync {
+    fn count(&self) -> usize;
+    fn bounds(&self, i: u32) -> Aabb;
+    /// The corners of primitive `i` if it is a plain triangle: the BVH packs these into
+    /// its SIMD leaves, and cells use them for the exact overlap test.
+    fn triangle(&self, i: u32) -> Option<[Vec3A; 3]>;
+    /// The hit of `ray` with primitive `i` in `(ray.t_min, t_max]`, with `prim = i`.
+    fn intersect(&self, i: u32, ray: &PreparedRay, t_max: f32) -> Option<Hit>;
+    /// Whether primitive `i` has any hit in `(ray.t_min, t_max]`.
+    #[inline(always)]
+    fn occludes(&self, i: u32, ray: &PreparedRay, t_max: f32) -> bool {
+        self.intersect(i, ray, t_max).is_some()
+    }
+}
+
+impl PrimitiveSet for [Primitive] {
+    #[inline(always)]
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        self[i as usize].bounds()
+    }
+
+    fn triangle(&self, i: u32) -> Option<[Vec3A; 3]> {
+        self[i as usize].triangle()
+    }
+
+    #[inline(always)]
+    fn intersect(&self, i: u32, ray: &PreparedRay, t_max: f32) -> Option<Hit> {
+        self[i as usize].intersect(i, ray, t_max)
+    }
+
+    #[inline(always)]
+    fn occludes(&self, i: u32, ray: &PreparedRay, t_max: f32) -> bool {
+        self[i as usize].occludes(ray, t_max)
+    }
+}
+
+/// The primitives a structure holds: every one with finite bounds, as `(index, bounds)`.
+/// Unbounded ones (planes) are tested outside any structure
+/// ([`crate::geometry::Geometry`]).
+pub fn bounded<P: PrimitiveSet + ?Sized>(prims: &P) -> impl Iterator<Item = (u32, Aabb)> + '_ {
+    (0..prims.count() as u32).filter_map(|i| {
+        let b = prims.bounds(i);
+        is_bounded(&b).then_some((i, b))
     })
 }
 
@@ -50,11 +94,12 @@ pub fn is_bounded(b: &Aabb) -> bool {
     b.min.is_finite() && b.max.is_finite()
 }
 
-pub trait Accelerator: Send + Sync {
+/// A structure over the primitive set `P` it was built for.
+pub trait Accelerator<P: PrimitiveSet + ?Sized>: Send + Sync {
     /// The closest hit with `ray.t_min < t <= ray.t_max`.
-    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit>;
+    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit>;
     /// Whether anything lies in `(ray.t_min, ray.t_max]` (shadow rays).
-    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool;
+    fn occluded(&self, prims: &P, ray: &Ray) -> bool;
     /// Bytes used by the structure itself (not counting the primitives).
     fn memory_bytes(&self) -> usize;
 }
@@ -87,7 +132,7 @@ impl AccelKind {
             .expect("every kind is in ALL")]
     }
 
-    pub fn build(self, prims: &[Primitive]) -> Box<dyn Accelerator> {
+    pub fn build<P: PrimitiveSet + ?Sized + 'static>(self, prims: &P) -> Box<dyn Accelerator<P>> {
         match self {
             AccelKind::Bvh => Box::new(bvh::Bvh::build(prims)),
             AccelKind::KdTree => Box::new(kdtree::KdTree::build(prims)),

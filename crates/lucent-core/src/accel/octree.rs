@@ -14,10 +14,9 @@
 
 use super::cell_walk::{self, CellWalk};
 use super::overlap::{cell_padding, overlaps, padded};
-use super::{search_limit, Accelerator};
+use super::{search_limit, Accelerator, PrimitiveSet};
 use crate::aabb::Aabb;
 use crate::hit::Hit;
-use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 
 const MAX_LEAF: usize = 8;
@@ -55,15 +54,15 @@ fn octant(b: &Aabb, i: usize) -> Aabb {
     o
 }
 
-struct Builder<'a> {
-    prims: &'a [Primitive],
+struct Builder<'a, P: ?Sized> {
+    prims: &'a P,
     boxes: Vec<Aabb>,
     pad: f32,
     nodes: Vec<OctNode>,
     prim_ids: Vec<u32>,
 }
 
-impl Builder<'_> {
+impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
     fn build(&mut self, me: usize, cell: &Aabb, items: Vec<u32>, depth: usize) {
         let leaf = |b: &mut Self, items: &[u32]| {
             b.nodes[me] = OctNode {
@@ -83,7 +82,7 @@ impl Builder<'_> {
                     .copied()
                     .filter(|&p| {
                         let b = &self.boxes[p as usize];
-                        b.min.cmple(o.max).all() && o.min.cmple(b.max).all() && overlaps(&self.prims[p as usize], &o)
+                        b.min.cmple(o.max).all() && o.min.cmple(b.max).all() && overlaps(self.prims, p, &o)
                     })
                     .collect()
             })
@@ -105,8 +104,8 @@ impl Builder<'_> {
 }
 
 impl Octree {
-    pub fn build(prims: &[Primitive]) -> Octree {
-        let boxes: Vec<Aabb> = prims.iter().map(|p| p.bounds()).collect();
+    pub fn build<P: PrimitiveSet + ?Sized>(prims: &P) -> Octree {
+        let boxes: Vec<Aabb> = (0..prims.count() as u32).map(|i| prims.bounds(i)).collect();
         let items: Vec<u32> = super::bounded(prims).map(|(i, _)| i).collect();
         let scene = items.iter().fold(Aabb::EMPTY, |b, &i| b.union(&boxes[i as usize]));
         if items.is_empty() {
@@ -131,7 +130,7 @@ impl Octree {
             bounds,
             nodes: b.nodes,
             prim_ids: b.prim_ids,
-            prim_count: prims.len(),
+            prim_count: prims.count(),
         }
     }
 }
@@ -211,12 +210,12 @@ impl CellWalk for Octree {
     }
 }
 
-impl Accelerator for Octree {
-    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Octree {
+    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
         cell_walk::closest_hit(self, prims, ray)
     }
 
-    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
         cell_walk::occluded(self, prims, ray)
     }
 

@@ -6,9 +6,9 @@
 //! primitive into a cell it merely touches, never leave it out of one it overlaps: a
 //! structure that leaves a primitive out of a cell the ray crosses would miss its hit.
 
+use super::PrimitiveSet;
 use crate::aabb::Aabb;
 use crate::math::{DVec3, Vec3A};
-use crate::primitive::{Primitive, Shape};
 
 /// How much cells grow before primitives are assigned to them: a small fraction of the
 /// scene's size, far above f32 rounding and far below any cell a build makes.
@@ -31,10 +31,10 @@ fn d(v: Vec3A) -> DVec3 {
 
 /// Whether a primitive overlaps box `b` (faces included). Exact for triangles; other
 /// shapes are represented by their bounding box.
-pub fn overlaps(prim: &Primitive, b: &Aabb) -> bool {
-    match &prim.shape {
-        Shape::Triangle { p, .. } => triangle_overlaps_box(p, b),
-        _ => boxes_overlap(&prim.bounds(), b),
+pub fn overlaps<P: PrimitiveSet + ?Sized>(prims: &P, i: u32, b: &Aabb) -> bool {
+    match prims.triangle(i) {
+        Some(p) => triangle_overlaps_box(&p, b),
+        None => boxes_overlap(&prims.bounds(i), b),
     }
 }
 
@@ -82,11 +82,11 @@ pub fn triangle_overlaps_box(p: &[Vec3A; 3], b: &Aabb) -> bool {
 /// Bounds of the part of the primitive inside `b`, or `None` if it does not overlap.
 /// Triangles are clipped (Sutherland–Hodgman against the six planes); other shapes
 /// use their bounding box cut to `b`.
-pub fn clipped_bounds(prim: &Primitive, b: &Aabb) -> Option<Aabb> {
-    match &prim.shape {
-        Shape::Triangle { p, .. } => clip_triangle(p, b),
-        _ => {
-            let pb = prim.bounds();
+pub fn clipped_bounds<P: PrimitiveSet + ?Sized>(prims: &P, i: u32, b: &Aabb) -> Option<Aabb> {
+    match prims.triangle(i) {
+        Some(p) => clip_triangle(&p, b),
+        None => {
+            let pb = prims.bounds(i);
             boxes_overlap(&pb, b).then(|| Aabb {
                 min: pb.min.max(b.min),
                 max: pb.max.min(b.max),

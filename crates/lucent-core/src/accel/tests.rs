@@ -9,9 +9,11 @@ use crate::math::Vec3A;
 use crate::primitive::{Primitive, Shape};
 use crate::ray::Ray;
 
+type Named = (String, Box<dyn Accelerator<[Primitive]>>);
+
 /// Every structure, and the BVH with each box-test implementation this CPU can run.
-fn structures(prims: &[Primitive]) -> Vec<(String, Box<dyn Accelerator>)> {
-    let mut all: Vec<(String, Box<dyn Accelerator>)> = AccelKind::ALL
+fn structures(prims: &[Primitive]) -> Vec<Named> {
+    let mut all: Vec<Named> = AccelKind::ALL
         .iter()
         .filter(|&&k| k != AccelKind::List)
         .map(|&k| (k.name().to_string(), k.build(prims)))
@@ -116,18 +118,19 @@ fn coplanar_grid_with_axis_parallel_rays_matches_the_list() {
 fn rays_starting_on_a_surface_match_the_list() {
     // Secondary rays leave hit points, as the renderer's shadow and mirror rays do.
     let prims = soup(8, 500);
-    let list = PrimitiveList::new(&prims);
+    let prims = prims.as_slice();
+    let list = PrimitiveList::new(prims);
     let mut rng = Rng(77);
     let mut rays = Vec::new();
     for r in random_rays(&mut rng, 3000, 15.0, 8.0) {
-        if let Some(h) = list.closest_hit(&prims, &r) {
+        if let Some(h) = list.closest_hit(prims, &r) {
             let d = rng.vec(1.0).normalize();
             rays.push(Ray::segment(r.at(h.t), d, 1e-4, f32::INFINITY));
             rays.push(Ray::segment(r.at(h.t), d, 0.0, 5.0));
         }
     }
     assert!(rays.len() > 500);
-    check_against_list(&prims, &rays);
+    check_against_list(prims, &rays);
 }
 
 #[test]

@@ -13,10 +13,10 @@ use std::time::Instant;
 use clap::Args;
 use lucent_core::accel::{AccelKind, Accelerator};
 use lucent_core::math::Vec3A;
-use lucent_core::primitive::{Primitive, Shape};
+use lucent_core::mesh::TriangleMesh;
 use lucent_core::ray::Ray;
 use lucent_io::image::write_file_atomically;
-use lucent_io::mesh::load_obj;
+use lucent_io::obj::load_obj;
 use rayon::prelude::*;
 
 use crate::EXIT_BAD_INPUT;
@@ -76,7 +76,7 @@ fn read_rays(path: &std::path::Path) -> Result<Vec<Ray>, String> {
 
 /// One query: `(t, triangle)` as the answer file stores it.
 #[inline(always)]
-fn answer(accel: &dyn Accelerator, prims: &[Primitive], ray: &Ray, occluded: bool) -> (f32, u32) {
+fn answer(accel: &dyn Accelerator<TriangleMesh>, prims: &TriangleMesh, ray: &Ray, occluded: bool) -> (f32, u32) {
     if occluded {
         if accel.occluded(prims, ray) {
             (0.0, 0)
@@ -106,17 +106,10 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     if let Some(out) = &args.hits {
         lucent_io::image::check_writable(out).map_err(|e| e.to_string())?;
     }
-    let mesh = load_obj(&args.mesh)?;
+    let mesh = load_obj(&args.mesh)
+        .map_err(|e| format!("{}: {e}", args.mesh.display()))?
+        .mesh;
     let rays = read_rays(&args.rays)?;
-    let prims: Vec<Primitive> = (0..mesh.triangles.len())
-        .map(|k| Primitive {
-            shape: Shape::Triangle {
-                p: mesh.corners(k),
-                normals: None,
-            },
-            material: 0,
-        })
-        .collect();
 
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
@@ -129,7 +122,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     for _ in 0..args.reps.min(3) {
         drop(accel.take());
         let t = Instant::now();
-        accel = Some(kind.build(&prims));
+        accel = Some(kind.build(&mesh));
         build_times.push(t.elapsed().as_secs_f64());
     }
     let accel = accel.expect("at least one build");
@@ -141,7 +134,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         answers.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
             let rays = &rays[c * CHUNK..];
             for (a, ray) in out.iter_mut().zip(rays) {
-                *a = answer(accel.as_ref(), &prims, ray, args.occluded);
+                *a = answer(accel.as_ref(), &mesh, ray, args.occluded);
             }
         });
     };
@@ -168,11 +161,11 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     println!(
         "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
-        accel.memory_bytes() as f64 / prims.len().max(1) as f64,
+        accel.memory_bytes() as f64 / mesh.indices.len().max(1) as f64,
         rays.len(),
         kind.name(),
         pool.current_num_threads(),
-        prims.len(),
+        mesh.indices.len(),
     );
     Ok(())
 }

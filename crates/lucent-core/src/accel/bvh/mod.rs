@@ -16,9 +16,8 @@ mod packet;
 mod traverse;
 mod wide;
 
-use super::Accelerator;
+use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
-use crate::primitive::Primitive;
 use crate::ray::{PreparedRay, Ray};
 use packet::Packet;
 use wide::WideNode;
@@ -55,12 +54,12 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    pub fn build(prims: &[Primitive]) -> Bvh {
+    pub fn build<P: PrimitiveSet + ?Sized>(prims: &P) -> Bvh {
         Bvh::build_for(prims, Isa::detect())
     }
 
     /// Builds for a given instruction set (tests use this to check every path).
-    pub fn build_for(prims: &[Primitive], isa: Isa) -> Bvh {
+    pub fn build_for<P: PrimitiveSet + ?Sized>(prims: &P, isa: Isa) -> Bvh {
         let tree = binary::build(super::bounded(prims));
         let wide = wide::collapse(&tree, prims);
         #[cfg(target_arch = "x86_64")]
@@ -91,21 +90,21 @@ impl Bvh {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn closest_avx2(b: &Bvh, prims: &[Primitive], r: &PreparedRay, zero: bool) -> Option<Hit> {
+unsafe fn closest_avx2<P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, zero: bool) -> Option<Hit> {
     if zero {
-        traverse::closest::<traverse::Avx, true>(&b.nodes, &b.packets, prims, r)
+        traverse::closest::<traverse::Avx, true, P>(&b.nodes, &b.packets, prims, r)
     } else {
-        traverse::closest::<traverse::Avx, false>(&b.nodes, &b.packets, prims, r)
+        traverse::closest::<traverse::Avx, false, P>(&b.nodes, &b.packets, prims, r)
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn occluded_avx2(b: &Bvh, prims: &[Primitive], r: &PreparedRay, zero: bool) -> bool {
+unsafe fn occluded_avx2<P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, zero: bool) -> bool {
     if zero {
-        traverse::occluded::<traverse::Avx, true>(&b.nodes, &b.packets, prims, r)
+        traverse::occluded::<traverse::Avx, true, P>(&b.nodes, &b.packets, prims, r)
     } else {
-        traverse::occluded::<traverse::Avx, false>(&b.nodes, &b.packets, prims, r)
+        traverse::occluded::<traverse::Avx, false, P>(&b.nodes, &b.packets, prims, r)
     }
 }
 
@@ -113,8 +112,8 @@ fn has_zero_axis(r: &PreparedRay) -> bool {
     r.zero_axes.any()
 }
 
-impl Accelerator for Bvh {
-    fn closest_hit(&self, prims: &[Primitive], ray: &Ray) -> Option<Hit> {
+impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
+    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -127,16 +126,16 @@ impl Accelerator for Bvh {
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx2 => closest_avx2(self, prims, &r, zero),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => traverse::closest::<traverse::Sse, true>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 if zero => traverse::closest::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, &r),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => traverse::closest::<traverse::Sse, false>(&self.nodes, &self.packets, prims, &r),
-                _ if zero => traverse::closest::<traverse::Scalar, true>(&self.nodes, &self.packets, prims, &r),
-                _ => traverse::closest::<traverse::Scalar, false>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 => traverse::closest::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, &r),
+                _ if zero => traverse::closest::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, &r),
+                _ => traverse::closest::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, &r),
             }
         }
     }
 
-    fn occluded(&self, prims: &[Primitive], ray: &Ray) -> bool {
+    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -148,11 +147,13 @@ impl Accelerator for Bvh {
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx2 => occluded_avx2(self, prims, &r, zero),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => traverse::occluded::<traverse::Sse, true>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 if zero => {
+                    traverse::occluded::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, &r)
+                }
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => traverse::occluded::<traverse::Sse, false>(&self.nodes, &self.packets, prims, &r),
-                _ if zero => traverse::occluded::<traverse::Scalar, true>(&self.nodes, &self.packets, prims, &r),
-                _ => traverse::occluded::<traverse::Scalar, false>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 => traverse::occluded::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, &r),
+                _ if zero => traverse::occluded::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, &r),
+                _ => traverse::occluded::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, &r),
             }
         }
     }
@@ -170,7 +171,7 @@ mod tests {
     #[test]
     fn every_primitive_is_in_exactly_one_leaf_and_nodes_are_wide() {
         let prims = soup(11, 5000);
-        let bvh = Bvh::build(&prims);
+        let bvh = Bvh::build(prims.as_slice());
         let mut seen = bvh.leaf_prims();
         seen.sort_unstable();
         assert!(seen.iter().copied().eq(0..prims.len() as u32));

@@ -9,8 +9,8 @@
 //! sit in a packet as a flagged index with NaN corners and are tested by the scalar
 //! primitive code; unused lanes hold NaN corners, which no test accepts.
 
+use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
-use crate::primitive::{Primitive, Shape};
 use crate::ray::PreparedRay;
 use crate::shape::triangle;
 
@@ -32,15 +32,15 @@ pub struct Packet {
 
 impl Packet {
     /// Packs up to four primitives.
-    pub fn new(prims: &[Primitive], ids: &[u32]) -> Packet {
+    pub fn new<P: PrimitiveSet + ?Sized>(prims: &P, ids: &[u32]) -> Packet {
         debug_assert!(!ids.is_empty() && ids.len() <= LANES);
         let mut pk = Packet {
             p: [[[f32::NAN; LANES]; 3]; 3],
             ids: [UNUSED; LANES],
         };
         for (lane, &id) in ids.iter().enumerate() {
-            match &prims[id as usize].shape {
-                Shape::Triangle { p, .. } => {
+            match prims.triangle(id) {
+                Some(p) => {
                     for (corner, v) in p.iter().enumerate() {
                         for axis in 0..3 {
                             pk.p[corner][axis][lane] = v[axis];
@@ -48,7 +48,7 @@ impl Packet {
                     }
                     pk.ids[lane] = id;
                 }
-                _ => pk.ids[lane] = id | OTHER,
+                None => pk.ids[lane] = id | OTHER,
             }
         }
         pk
@@ -62,7 +62,13 @@ impl Packet {
 
     /// Updates `best` (and `t_max`, the distance limit) with the closest hit in this packet.
     #[inline(always)]
-    pub fn closest(&self, prims: &[Primitive], r: &PreparedRay, t_max: &mut f32, best: &mut Option<Hit>) {
+    pub fn closest<P: PrimitiveSet + ?Sized>(
+        &self,
+        prims: &P,
+        r: &PreparedRay,
+        t_max: &mut f32,
+        best: &mut Option<Hit>,
+    ) {
         let lanes = self.triangle_lanes(r, *t_max);
         for lane in Lanes(lanes.mask) {
             let (t, b1, b2) = (
@@ -70,24 +76,25 @@ impl Packet {
                 lanes.v[lane] * lanes.inv_det[lane],
                 lanes.w[lane] * lanes.inv_det[lane],
             );
-            self.record(t, lane, b1, b2, t_max, best);
+            Self::record(Hit::new(t, self.ids[lane], b1, b2), t_max, best);
         }
         for lane in Lanes(lanes.scalar) {
             let id = self.ids[lane];
             let hit = if id & OTHER != 0 {
-                prims[(id & !OTHER) as usize].intersect(r, *t_max)
+                prims.intersect(id & !OTHER, r, *t_max)
             } else {
                 self.scalar_triangle(r, lane, *t_max)
+                    .map(|(t, b1, b2)| Hit::new(t, id, b1, b2))
             };
-            if let Some((t, b1, b2)) = hit {
-                self.record(t, lane, b1, b2, t_max, best);
+            if let Some(hit) = hit {
+                Self::record(hit, t_max, best);
             }
         }
     }
 
     /// Whether anything in this packet lies within `(t_min, t_max]`.
     #[inline(always)]
-    pub fn any_hit(&self, prims: &[Primitive], r: &PreparedRay, t_max: f32) -> bool {
+    pub fn any_hit<P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, t_max: f32) -> bool {
         let lanes = self.triangle_lanes(r, t_max);
         if lanes.mask != 0 {
             return true;
@@ -95,7 +102,7 @@ impl Packet {
         Lanes(lanes.scalar).any(|lane| {
             let id = self.ids[lane];
             if id & OTHER != 0 {
-                prims[(id & !OTHER) as usize].intersect(r, t_max).is_some()
+                prims.occludes(id & !OTHER, r, t_max)
             } else {
                 self.scalar_triangle(r, lane, t_max).is_some()
             }
@@ -103,11 +110,10 @@ impl Packet {
     }
 
     #[inline(always)]
-    fn record(&self, t: f32, lane: usize, b1: f32, b2: f32, t_max: &mut f32, best: &mut Option<Hit>) {
-        let prim = self.ids[lane] & !OTHER;
-        if Hit::is_closer_than(t, prim, best) {
-            *best = Some(Hit { t, prim, b1, b2 });
-            *t_max = t;
+    fn record(hit: Hit, t_max: &mut f32, best: &mut Option<Hit>) {
+        if Hit::is_closer_than(hit.t, hit.prim, best) {
+            *best = Some(hit);
+            *t_max = hit.t;
         }
     }
 

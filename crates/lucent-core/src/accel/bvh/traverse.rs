@@ -14,9 +14,9 @@ use std::mem::MaybeUninit;
 use super::packet::Packet;
 use super::wide::{WideNode, FIRST_MASK, LEAF, PACKET_SHIFT, WIDTH};
 use crate::accel::search_limit;
+use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
 use crate::math::gamma;
-use crate::primitive::Primitive;
 use crate::ray::PreparedRay;
 
 /// Each visit pushes at most `WIDTH - 1` entries and the tree is at most ~100 levels deep.
@@ -239,10 +239,10 @@ fn entry(dist: f32, reference: u32) -> u64 {
 }
 
 #[inline(always)]
-pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
+pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     nodes: &[WideNode],
     packets: &[Packet],
-    prims: &[Primitive],
+    prims: &P,
     r: &PreparedRay,
 ) -> Option<Hit> {
     let rb = T::prepare(&RayBoxes::new(r));
@@ -319,10 +319,10 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool>(
 }
 
 #[inline(always)]
-pub unsafe fn occluded<T: BoxTest, const ZERO: bool>(
+pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     nodes: &[WideNode],
     packets: &[Packet],
-    prims: &[Primitive],
+    prims: &P,
     r: &PreparedRay,
 ) -> bool {
     let rb = T::prepare(&RayBoxes::new(r));

@@ -8,7 +8,7 @@
 
 use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
 use super::packet::{Packet, LANES};
-use crate::primitive::Primitive;
+use crate::accel::PrimitiveSet;
 
 pub const WIDTH: usize = 8;
 /// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`;
@@ -49,10 +49,10 @@ pub struct WideTree {
     pub packets: Vec<Packet>,
 }
 
-pub fn collapse(tree: &BinaryTree, prims: &[Primitive]) -> WideTree {
+pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
     let mut out = WideTree {
         nodes: Vec::with_capacity(tree.nodes.len() / 4 + 1),
-        packets: Vec::with_capacity(prims.len() / 3 + 1),
+        packets: Vec::with_capacity(prims.count() / 3 + 1),
     };
     if let Some(root) = tree.nodes.first() {
         match root.kind {
@@ -80,7 +80,7 @@ fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u3
 }
 
 /// Emits the packets of a binary leaf; returns its slot reference.
-fn leaf_slot(tree: &BinaryTree, leaf: &BinaryNode, prims: &[Primitive], out: &mut WideTree) -> u32 {
+fn leaf_slot<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, leaf: &BinaryNode, prims: &P, out: &mut WideTree) -> u32 {
     let Kind::Leaf { start, count } = leaf.kind else {
         unreachable!("a leaf")
     };
@@ -101,7 +101,7 @@ fn leaf_slot(tree: &BinaryTree, leaf: &BinaryNode, prims: &[Primitive], out: &mu
 }
 
 /// Builds the wide node standing for interior binary node `b`; returns its index.
-fn collapse_node(tree: &BinaryTree, b: u32, prims: &[Primitive], out: &mut WideTree) -> u32 {
+fn collapse_node<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, b: u32, prims: &P, out: &mut WideTree) -> u32 {
     let Kind::Interior { left, right } = tree.nodes[b as usize].kind else {
         unreachable!("interior")
     };

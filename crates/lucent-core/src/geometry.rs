@@ -1,0 +1,80 @@
+//! A set of primitives with its acceleration structure: the whole scene, or one object
+//! that `instance` places many times ([`crate::instance`]).
+
+use crate::accel::{AccelKind, Accelerator};
+use crate::hit::{Hit, SurfacePoint};
+use crate::math::Vec3A;
+use crate::primitive::Primitive;
+use crate::ray::{PreparedRay, Ray};
+
+pub struct Geometry {
+    pub primitives: Vec<Primitive>,
+    /// Per-vertex normals of `trinormal` triangles, indexed by `Shape::Triangle::normals`.
+    pub vertex_normals: Vec<[Vec3A; 3]>,
+    accel: Box<dyn Accelerator<[Primitive]>>,
+    /// Primitives without finite bounds (planes), tested by every ray outside `accel`.
+    unbounded: Vec<u32>,
+}
+
+impl Geometry {
+    pub fn new(primitives: Vec<Primitive>, vertex_normals: Vec<[Vec3A; 3]>, accel: AccelKind) -> Geometry {
+        let unbounded = (0..primitives.len() as u32)
+            .filter(|&i| !crate::accel::is_bounded(&primitives[i as usize].bounds()))
+            .collect();
+        Geometry {
+            accel: accel.build(primitives.as_slice()),
+            unbounded,
+            primitives,
+            vertex_normals,
+        }
+    }
+
+    #[inline]
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        let mut best = self.accel.closest_hit(&self.primitives, ray);
+        if !self.unbounded.is_empty() {
+            let r = PreparedRay::new(*ray);
+            for &i in &self.unbounded {
+                let t_max = best.map_or(ray.t_max, |b| b.t);
+                if let Some(hit) = self.primitives[i as usize].intersect(i, &r, t_max) {
+                    // The same tie rule as inside the structures: scene order.
+                    if Hit::is_closer_than(hit.t, i, &best) {
+                        best = Some(hit);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        if !self.unbounded.is_empty() {
+            let r = PreparedRay::new(*ray);
+            if self
+                .unbounded
+                .iter()
+                .any(|&i| self.primitives[i as usize].occludes(&r, ray.t_max))
+            {
+                return true;
+            }
+        }
+        self.accel.occluded(&self.primitives, ray)
+    }
+
+    /// Shading data at `hit` on the ray `origin + t·dir`.
+    pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> SurfacePoint {
+        self.primitives[hit.prim as usize].surface_point(hit, origin, dir, &self.vertex_normals)
+    }
+
+    /// How many simple primitives the scene shows: every triangle of every mesh, and
+    /// every primitive of an object once per instance.
+    pub fn shown_primitive_count(&self) -> u64 {
+        self.primitives.iter().map(|p| p.shown_count()).sum()
+    }
+
+    /// The structure alone.
+    pub fn accel_memory_bytes(&self) -> usize {
+        self.accel.memory_bytes()
+    }
+}

@@ -1,0 +1,80 @@
+//! An object placed in the scene by `instance`: shared geometry (never copied) seen
+//! through a transform. This is the second level of a two-level structure: the scene's
+//! structure finds the instance by its world bounds, the ray goes into the object's
+//! space, and the object's own structure finds the primitive.
+
+use std::sync::Arc;
+
+use crate::aabb::Aabb;
+use crate::geometry::Geometry;
+use crate::hit::{Hit, SurfacePoint};
+use crate::math::{Affine3A, Mat3A, Vec3A};
+use crate::ray::{PreparedRay, Ray};
+
+#[derive(Clone)]
+pub struct Instance {
+    pub object: Arc<Geometry>,
+    pub world_to_object: Affine3A,
+    pub object_to_world: Affine3A,
+    /// Inverse transpose of the object-to-world linear part: carries normals to world.
+    pub normal_to_world: Mat3A,
+    pub bounds: Aabb,
+}
+
+impl std::fmt::Debug for Instance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Instance({} primitives)", self.object.primitives.len())
+    }
+}
+
+impl Instance {
+    /// `object_bounds` are the bounds of the object's bounded primitives.
+    pub fn new(object: Arc<Geometry>, object_bounds: Aabb, object_to_world: Affine3A) -> Instance {
+        let world_to_object = object_to_world.inverse();
+        Instance {
+            object,
+            world_to_object,
+            object_to_world,
+            normal_to_world: world_to_object.matrix3.transpose(),
+            bounds: object_bounds.transformed(&object_to_world),
+        }
+    }
+
+    /// The ray in object space. The direction is not renormalised, so `t` means the same
+    /// point in both spaces.
+    #[inline(always)]
+    fn to_object(&self, ray: &Ray, t_max: f32) -> Ray {
+        Ray {
+            origin: self.world_to_object.transform_point3a(ray.origin),
+            dir: self.world_to_object.transform_vector3a(ray.dir),
+            t_min: ray.t_min,
+            t_max,
+        }
+    }
+
+    /// The closest hit: `prim` is the object's primitive, `inner[0]` the triangle if
+    /// that is a mesh.
+    #[inline]
+    pub fn intersect(&self, ray: &PreparedRay, t_max: f32) -> Option<Hit> {
+        self.object.closest_hit(&self.to_object(&ray.ray, t_max))
+    }
+
+    #[inline]
+    pub fn occludes(&self, ray: &PreparedRay, t_max: f32) -> bool {
+        self.object.occluded(&self.to_object(&ray.ray, t_max))
+    }
+
+    /// Shading data in world space at `hit` (as [`Instance::intersect`] gave it).
+    pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> SurfacePoint {
+        let o = self.world_to_object.transform_point3a(origin);
+        let d = self.world_to_object.transform_vector3a(dir);
+        let sp = self.object.surface_point(hit, o, d);
+        SurfacePoint {
+            // Recomputed in world space rather than transformed back: the same rounding
+            // as every other primitive's hit point.
+            point: origin + dir * hit.t,
+            normal: (self.normal_to_world * sp.normal).normalize(),
+            ..sp
+        }
+    }
+}

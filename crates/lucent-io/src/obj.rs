@@ -1,0 +1,176 @@
+//! Triangle meshes from Wavefront OBJ files, through `tobj`, with their MTL materials.
+//!
+//! Polygons are fan-triangulated in file order (`v0 v1 v2`, `v0 v2 v3`, …), so triangle
+//! `k` of a mesh is the `k`-th triangle of the file's faces in the order they appear —
+//! the numbering the benchmark's answer files use. Every object and group of the file
+//! goes into one mesh; vertices that share a position but not a normal or texture
+//! coordinate are split (tobj's `single_index`).
+
+use std::path::Path;
+
+use crate::mesh_file::{LoadedMesh, MeshMaterial, NO_MATERIAL};
+use glam::{Vec2, Vec3};
+
+pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| format!("cannot read OBJ mesh: {e}"))?;
+    let mut out = LoadedMesh::default();
+    match materials {
+        Ok(list) => {
+            out.library = list
+                .into_iter()
+                .map(|m| MeshMaterial {
+                    name: m.name,
+                    diffuse: m.diffuse,
+                    specular: m.specular,
+                    shininess: m.shininess,
+                    emission: m.emissive,
+                    diffuse_texture: m.diffuse_texture,
+                })
+                .collect()
+        }
+        Err(e) => {
+            if models.iter().any(|m| m.mesh.material_id.is_some()) || e != tobj::LoadError::GenericFailure {
+                out.warnings.push(format!(
+                    "cannot read the MTL material library ({e}); the current material is used"
+                ));
+            }
+        }
+    }
+    // Normals and texture coordinates are kept only when every part of the file has them.
+    let all_normals = models.iter().all(|m| !m.mesh.normals.is_empty());
+    let all_uvs = models.iter().all(|m| !m.mesh.texcoords.is_empty());
+    if !all_normals && models.iter().any(|m| !m.mesh.normals.is_empty()) {
+        out.warnings
+            .push("some faces have vertex normals and some do not: the whole mesh is shaded flat".into());
+    }
+    let mesh = &mut out.mesh;
+    let mut multi_material = false;
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len() as u32;
+        let count = m.positions.len() / 3;
+        mesh.positions
+            .extend(m.positions.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])));
+        if all_normals {
+            mesh.normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or_zero()),
+            );
+            mesh.normals.resize(mesh.positions.len(), Vec3::ZERO);
+        }
+        if all_uvs {
+            mesh.uvs
+                .extend(m.texcoords.chunks_exact(2).map(|t| Vec2::new(t[0], t[1])));
+            mesh.uvs.resize(mesh.positions.len(), Vec2::ZERO);
+        }
+        let material = match m.material_id {
+            Some(i) if i < out.library.len() => {
+                multi_material = true;
+                i as u32
+            }
+            _ => NO_MATERIAL,
+        };
+        for (k, tri) in m.indices.chunks_exact(3).enumerate() {
+            if tri.iter().any(|&i| i as usize >= count) {
+                return Err(format!(
+                    "triangle {k} of object '{}' refers to a vertex that does not exist",
+                    model.name
+                ));
+            }
+            mesh.indices.push([base + tri[0], base + tri[1], base + tri[2]]);
+            mesh.materials.push(material);
+        }
+    }
+    if !multi_material {
+        mesh.materials.clear();
+    }
+    mesh.check()?;
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp_dir(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("lucent-obj-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn polygons_are_fan_triangulated_in_file_order() {
+        let dir = temp_dir("fan");
+        let path = dir.join("quad.obj");
+        std::fs::write(
+            &path,
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n# a quad, then a triangle\nf 1 2 3 4\nf 1 2 5\n",
+        )
+        .unwrap();
+        let m = load_obj(&path).unwrap().mesh;
+        assert_eq!(m.indices.len(), 3);
+        let z = |k: u32| m.corners(k).map(|p| (p.x, p.y, p.z));
+        assert_eq!(z(0), [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (1.0, 1.0, 0.0)]);
+        assert_eq!(z(1), [(0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (0.0, 1.0, 0.0)]);
+        assert_eq!(z(2), [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)]);
+        assert!(m.normals.is_empty() && m.uvs.is_empty() && m.materials.is_empty());
+        assert!(load_obj(&dir.join("missing.obj")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn normals_texture_coordinates_and_materials_are_kept() {
+        let dir = temp_dir("mtl");
+        std::fs::write(
+            dir.join("two.mtl"),
+            "newmtl red\nKd 1 0 0\nKs 0.5 0.5 0.5\nNs 20\nnewmtl glow\nKe 1 1 0\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("two.obj"),
+            "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 2\n\
+             usemtl red\nf 1/1/1 2/2/1 3/3/1\nusemtl glow\nf 1/1/1 3/3/1 2/2/1\n",
+        )
+        .unwrap();
+        let loaded = load_obj(&dir.join("two.obj")).unwrap();
+        let m = &loaded.mesh;
+        assert_eq!(m.indices.len(), 2);
+        assert_eq!(m.normals.len(), m.positions.len());
+        assert!(m.normals.iter().all(|n| *n == Vec3::Z), "normals are made unit length");
+        assert_eq!(m.uvs[m.indices[0][1] as usize], Vec2::new(1.0, 0.0));
+        assert_eq!(loaded.library.len(), 2);
+        assert_eq!(loaded.library[0].diffuse, Some([1.0, 0.0, 0.0]));
+        assert_eq!(loaded.library[0].shininess, Some(20.0));
+        assert_eq!(loaded.library[1].emission, Some([1.0, 1.0, 0.0]));
+        assert_eq!(m.materials, vec![0, 1]);
+        assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+
+        // A missing library is a warning; the faces keep the current material.
+        std::fs::remove_file(dir.join("two.mtl")).unwrap();
+        let loaded = load_obj(&dir.join("two.obj")).unwrap();
+        assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
+        assert!(loaded.mesh.materials.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn malformed_files_are_errors() {
+        let dir = temp_dir("bad");
+        for (name, text) in [
+            ("oob.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n"),
+            ("nan.obj", "v 0 0 nan\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+            ("face.obj", "v 0 0 0\nf 1 x 3\n"),
+        ] {
+            std::fs::write(dir.join(name), text).unwrap();
+            assert!(load_obj(&dir.join(name)).is_err(), "{name}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,254 @@
+//! Triangle meshes from PLY files (ASCII and binary, either byte order), through
+//! `ply-rs-bw`.
+//!
+//! The `vertex` element gives `x y z`, and `nx ny nz` and texture coordinates (`u v`,
+//! `s t` or `texture_u texture_v`) when present; the `face` element gives
+//! `vertex_indices` (or `vertex_index`) lists, fan-triangulated in file order. Other
+//! elements and properties are read and ignored.
+
+use std::io::BufReader;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use lucent_core::mesh::TriangleMesh;
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property, PropertyAccess};
+
+use crate::mesh_file::LoadedMesh;
+
+/// One `vertex` element: every property lucent understands, `NaN` where absent.
+struct Vertex {
+    p: [f64; 3],
+    n: [f64; 3],
+    uv: [f64; 2],
+}
+
+struct Face {
+    indices: Vec<i64>,
+    /// A property that should have been an index list but was not (reported by name).
+    bad: Option<String>,
+}
+
+fn scalar(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::Char(v) => v as f64,
+        Property::UChar(v) => v as f64,
+        Property::Short(v) => v as f64,
+        Property::UShort(v) => v as f64,
+        Property::Int(v) => v as f64,
+        Property::UInt(v) => v as f64,
+        Property::Float(v) => v as f64,
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
+fn integer_list(p: Property) -> Option<Vec<i64>> {
+    Some(match p {
+        Property::ListChar(v) => v.into_iter().map(i64::from).collect(),
+        Property::ListUChar(v) => v.into_iter().map(i64::from).collect(),
+        Property::ListShort(v) => v.into_iter().map(i64::from).collect(),
+        Property::ListUShort(v) => v.into_iter().map(i64::from).collect(),
+        Property::ListInt(v) => v.into_iter().map(i64::from).collect(),
+        Property::ListUInt(v) => v.into_iter().map(i64::from).collect(),
+        _ => return None,
+    })
+}
+
+impl PropertyAccess for Vertex {
+    fn new() -> Self {
+        Vertex {
+            p: [f64::NAN; 3],
+            n: [f64::NAN; 3],
+            uv: [f64::NAN; 2],
+        }
+    }
+
+    fn set_property(&mut self, key: &str, property: Property) {
+        let Some(v) = scalar(&property) else { return };
+        match key {
+            "x" => self.p[0] = v,
+            "y" => self.p[1] = v,
+            "z" => self.p[2] = v,
+            "nx" => self.n[0] = v,
+            "ny" => self.n[1] = v,
+            "nz" => self.n[2] = v,
+            "u" | "s" | "texture_u" | "texture_s" => self.uv[0] = v,
+            "v" | "t" | "texture_v" | "texture_t" => self.uv[1] = v,
+            _ => {}
+        }
+    }
+}
+
+impl PropertyAccess for Face {
+    fn new() -> Self {
+        Face {
+            indices: Vec::new(),
+            bad: None,
+        }
+    }
+
+    fn set_property(&mut self, key: &str, property: Property) {
+        if key == "vertex_indices" || key == "vertex_index" {
+            match integer_list(property) {
+                Some(list) => self.indices = list,
+                None => self.bad = Some(key.to_string()),
+            }
+        }
+    }
+}
+
+pub fn load_ply(path: &Path) -> Result<LoadedMesh, String> {
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {}", crate::cse167::io_reason(&e)))?;
+    let mut reader = BufReader::new(file);
+    let bad = |e: std::io::Error| format!("malformed PLY file: {e}");
+    let vertex_parser = Parser::<Vertex>::new();
+    let face_parser = Parser::<Face>::new();
+    let other_parser = Parser::<DefaultElement>::new();
+    let header = vertex_parser.read_header(&mut reader).map_err(bad)?;
+    let mut vertices = None;
+    let mut faces = None;
+    for element in header.elements.values() {
+        match element.name.as_str() {
+            "vertex" => {
+                vertices = Some(
+                    vertex_parser
+                        .read_payload_for_element(&mut reader, element, &header)
+                        .map_err(bad)?,
+                )
+            }
+            "face" => {
+                faces = Some(
+                    face_parser
+                        .read_payload_for_element(&mut reader, element, &header)
+                        .map_err(bad)?,
+                )
+            }
+            _ => {
+                other_parser
+                    .read_payload_for_element(&mut reader, element, &header)
+                    .map_err(bad)?;
+            }
+        }
+    }
+    let vertices = vertices.ok_or("the PLY file has no 'vertex' element")?;
+    let faces = faces.ok_or("the PLY file has no 'face' element")?;
+
+    let mut mesh = TriangleMesh::default();
+    for (k, v) in vertices.iter().enumerate() {
+        if v.p.iter().any(|c| !c.is_finite()) {
+            return Err(format!("vertex {k} has no finite x, y and z"));
+        }
+        mesh.positions
+            .push(Vec3::new(v.p[0] as f32, v.p[1] as f32, v.p[2] as f32));
+    }
+    if vertices.iter().all(|v| v.n.iter().all(|c| c.is_finite())) {
+        mesh.normals = vertices
+            .iter()
+            .map(|v| Vec3::new(v.n[0] as f32, v.n[1] as f32, v.n[2] as f32).normalize_or_zero())
+            .collect();
+    }
+    if vertices.iter().all(|v| v.uv.iter().all(|c| c.is_finite())) {
+        mesh.uvs = vertices
+            .iter()
+            .map(|v| Vec2::new(v.uv[0] as f32, v.uv[1] as f32))
+            .collect();
+    }
+    let n = mesh.positions.len() as i64;
+    for (k, f) in faces.iter().enumerate() {
+        if let Some(name) = &f.bad {
+            return Err(format!("face {k}: property '{name}' is not a list of integers"));
+        }
+        if f.indices.len() < 3 {
+            return Err(format!("face {k} has {} vertices (at least 3 needed)", f.indices.len()));
+        }
+        if let Some(&i) = f.indices.iter().find(|&&i| i < 0 || i >= n) {
+            return Err(format!("face {k} refers to vertex {i} but the file has {n} vertices"));
+        }
+        for j in 1..f.indices.len() - 1 {
+            mesh.indices
+                .push([f.indices[0], f.indices[j], f.indices[j + 1]].map(|i| i as u32));
+        }
+    }
+    mesh.check()?;
+    Ok(LoadedMesh {
+        mesh,
+        ..LoadedMesh::default()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str =
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                          property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n\
+                          element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+    fn write(name: &str, bytes: &[u8]) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("lucent-ply-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        path
+    }
+
+    #[test]
+    fn ascii_quads_are_fanned_with_normals_and_uvs() {
+        let text = format!("{HEADER}0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n");
+        let m = load_ply(&write("quad.ply", text.as_bytes())).unwrap().mesh;
+        assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.normals, vec![Vec3::Z; 4]);
+        assert_eq!(m.uvs[2], Vec2::new(1.0, 1.0));
+    }
+
+    #[test]
+    fn binary_little_endian_with_extra_elements() {
+        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\nproperty double y\n\
+                          property double z\nproperty uchar red\nelement face 1\nproperty list uchar uint vertex_indices\n\
+                          element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+            .to_vec();
+        for p in [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0]] {
+            for c in p {
+                bytes.extend(c.to_le_bytes());
+            }
+            bytes.push(200);
+        }
+        bytes.push(3);
+        for i in [0u32, 1, 2] {
+            bytes.extend(i.to_le_bytes());
+        }
+        bytes.extend(0i32.to_le_bytes());
+        bytes.extend(1i32.to_le_bytes());
+        let m = load_ply(&write("bin.ply", &bytes)).unwrap().mesh;
+        assert_eq!(m.indices, vec![[0, 1, 2]]);
+        assert_eq!(m.positions[2], Vec3::new(0.0, 2.0, 0.0));
+        assert!(m.normals.is_empty() && m.uvs.is_empty());
+    }
+
+    #[test]
+    fn malformed_files_are_errors() {
+        let cases: [(&str, String); 5] = [
+            (
+                "header.ply",
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n".into(),
+            ),
+            (
+                "oob.ply",
+                format!("{HEADER}0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n3 0 1 7\n"),
+            ),
+            ("short.ply", format!("{HEADER}0 0 0 0 0 1 0 0\n")),
+            (
+                "twogon.ply",
+                format!("{HEADER}0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n2 0 1\n"),
+            ),
+            ("text.ply", "not a ply file\n".into()),
+        ];
+        for (name, text) in cases {
+            let e = load_ply(&write(name, text.as_bytes()));
+            assert!(e.is_err(), "{name}");
+        }
+        assert!(load_ply(Path::new("/nonexistent/x.ply")).is_err());
+    }
+}
