@@ -4,7 +4,7 @@
 use crate::accel::{AccelKind, Accelerator};
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::Vec3A;
-use crate::primitive::Primitive;
+use crate::primitive::{Primitive, Shape};
 use crate::ray::{PreparedRay, Ray};
 
 pub struct Geometry {
@@ -73,8 +73,24 @@ impl Geometry {
         self.primitives.iter().map(|p| p.shown_count()).sum()
     }
 
-    /// The structure alone.
+    /// Bytes of every acceleration structure: this one, and those of the meshes and
+    /// objects it holds, each shared one counted once.
     pub fn accel_memory_bytes(&self) -> usize {
-        self.accel.memory_bytes()
+        let mut seen = std::collections::HashSet::new();
+        self.accel_bytes_unique(&mut seen)
+    }
+
+    fn accel_bytes_unique(&self, seen: &mut std::collections::HashSet<usize>) -> usize {
+        let mut total = self.accel.memory_bytes();
+        for p in &self.primitives {
+            match &p.shape {
+                Shape::Mesh(m) if seen.insert(std::sync::Arc::as_ptr(m) as usize) => total += m.accel_memory_bytes(),
+                Shape::Instance(i) if seen.insert(std::sync::Arc::as_ptr(&i.object) as usize) => {
+                    total += i.object.accel_bytes_unique(seen)
+                }
+                _ => {}
+            }
+        }
+        total
     }
 }

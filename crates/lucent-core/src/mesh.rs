@@ -70,6 +70,34 @@ impl TriangleMesh {
         self.indices[k as usize].map(|i| Vec3A::from(self.positions[i as usize]))
     }
 
+    /// Adds the vertices and triangles of `other` (attributes are kept only if both
+    /// meshes have them).
+    pub fn append(&mut self, other: TriangleMesh) {
+        let base = self.positions.len() as u32;
+        let was_empty = self.indices.is_empty() && self.positions.is_empty();
+        let keep = |mine: bool, theirs: bool| (was_empty || mine) && theirs;
+        let normals = keep(!self.normals.is_empty(), !other.normals.is_empty());
+        let uvs = keep(!self.uvs.is_empty(), !other.uvs.is_empty());
+        self.positions.extend(other.positions);
+        if normals {
+            self.normals.extend(other.normals);
+        } else {
+            self.normals.clear();
+        }
+        if uvs {
+            self.uvs.extend(other.uvs);
+        } else {
+            self.uvs.clear();
+        }
+        self.indices.extend(other.indices.iter().map(|t| t.map(|i| i + base)));
+        if was_empty {
+            self.materials = other.materials;
+            self.material = other.material;
+        } else {
+            debug_assert!(self.materials.is_empty() && other.materials.is_empty());
+        }
+    }
+
     /// Drops triangles of zero area (or with non-finite normals from degenerate
     /// corners); returns how many went.
     pub fn remove_degenerate(&mut self) -> usize {
@@ -107,20 +135,19 @@ impl TriangleMesh {
         let k = hit.prim as usize;
         let [i0, i1, i2] = self.indices[k].map(|i| i as usize);
         let b0 = 1.0 - hit.b1 - hit.b2;
-        let normal = if self.normals.is_empty() {
+        let smooth = if self.normals.is_empty() {
+            None
+        } else {
+            let [n0, n1, n2] = [i0, i1, i2].map(|i| self.normals[i]);
+            // A zero vertex normal means the surface has none there (a degenerate patch
+            // corner), and opposite normals may cancel: both shade flat.
+            let n = Vec3A::from(n0 * b0 + n1 * hit.b1 + n2 * hit.b2).normalize();
+            (n0 != Vec3::ZERO && n1 != Vec3::ZERO && n2 != Vec3::ZERO && n.is_finite()).then_some(n)
+        };
+        let normal = smooth.unwrap_or_else(|| {
             let [a, b, c] = self.corners(hit.prim);
             triangle::geometric_normal(a, b, c)
-        } else {
-            let n = self.normals[i0] * b0 + self.normals[i1] * hit.b1 + self.normals[i2] * hit.b2;
-            let n = Vec3A::from(n).normalize();
-            if n.is_finite() {
-                n
-            } else {
-                // Opposite normals at the corners cancel: fall back to the face.
-                let [a, b, c] = self.corners(hit.prim);
-                triangle::geometric_normal(a, b, c)
-            }
-        };
+        });
         let uv = if self.uvs.is_empty() {
             Vec2::new(hit.b1, hit.b2)
         } else {
@@ -198,9 +225,9 @@ impl MeshShape {
         self.accel.occluded(&self.mesh, &Ray { t_max, ..ray.ray })
     }
 
-    /// Vertex data plus the structure.
-    pub fn memory_bytes(&self) -> usize {
-        self.mesh.memory_bytes() + self.accel.memory_bytes()
+    /// The structure over the triangles (not the vertex data).
+    pub fn accel_memory_bytes(&self) -> usize {
+        self.accel.memory_bytes()
     }
 }
 

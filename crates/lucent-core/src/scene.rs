@@ -72,7 +72,8 @@ impl Scene {
         self.accel_kind
     }
 
-    /// Bytes of the scene-level structure (not those inside meshes and objects).
+    /// Bytes of every acceleration structure of the scene (see
+    /// [`Geometry::accel_memory_bytes`]).
     pub fn accel_memory_bytes(&self) -> usize {
         self.geometry.accel_memory_bytes()
     }

@@ -4,16 +4,22 @@
 //! the core. It reports what the description cannot be rendered as (unsupported
 //! features, degenerate geometry) at the location of the command responsible.
 
-use glam::{DAffine3, DVec3};
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3, Vec3};
 use lucent_core::aabb::Aabb;
 use lucent_core::accel::AccelKind;
 use lucent_core::camera::Camera;
+use lucent_core::geometry::Geometry;
+use lucent_core::instance::Instance;
 use lucent_core::integrator::whitted::Whitted;
 use lucent_core::integrator::Integrator;
 use lucent_core::light::Light;
 use lucent_core::math::Vec3A;
+use lucent_core::mesh::{MeshShape, TriangleMesh};
 use lucent_core::primitive::{Analytic, AnalyticKind, Primitive, Shape, Sphere};
 use lucent_core::scene::{Scene, SceneParts};
+use lucent_core::shape::parametric::grid_mesh;
 use lucent_core::transform::Transform;
 
 use crate::desc::*;
@@ -62,67 +68,23 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         d => d as u32,
     };
 
-    let mut primitives = Vec::with_capacity(desc.shapes.len());
-    let mut vertex_normals = Vec::new();
-    for s in &desc.shapes {
-        let t = &desc.transforms[s.transform as usize];
-        if let ShapeKind::Nurbs { index } = s.kind {
-            let surface = &desc.nurbs[index as usize];
-            add_nurbs(surface, t, s.material, &c, height, &mut primitives, &mut vertex_normals);
-            continue;
-        }
-        let shape = match s.kind {
-            ShapeKind::Sphere { center, radius } => {
-                let m = t.m * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
-                Shape::Sphere(Sphere::new(Transform::to_f32(&m)))
+    let view = View {
+        camera: c,
+        height,
+        accel: options.accel,
+    };
+    // Objects first: instances in the scene refer to them.
+    let objects: Vec<Option<(Arc<Geometry>, Aabb)>> = (0..desc.objects.len() as u32)
+        .map(|o| {
+            let (prims, normals) = build_primitives(desc, Some(o), &[], &view, diags);
+            if prims.is_empty() {
+                return None;
             }
-            ShapeKind::Plane { .. }
-            | ShapeKind::Box { .. }
-            | ShapeKind::Cylinder { .. }
-            | ShapeKind::Disk { .. }
-            | ShapeKind::Cone { .. }
-            | ShapeKind::Quadric { .. } => {
-                Shape::Analytic(Box::new(Analytic::new(Transform::to_f32(&t.m), analytic_kind(&s.kind))))
-            }
-            ShapeKind::Triangle { v } => {
-                let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
-                Shape::Triangle { p, normals: None }
-            }
-            ShapeKind::Nurbs { .. } => unreachable!("expanded above"),
-            ShapeKind::TessellatedTri { v } => {
-                let p = v.map(|i| to_f32(t.point(desc.tessellated[i as usize].0)));
-                let n = v.map(|i| to_f32(t.normal(desc.tessellated[i as usize].1).normalize()));
-                smooth_triangle(p, n, &mut vertex_normals)
-            }
-            ShapeKind::TriNormal { v } => {
-                let p = v.map(|i| to_f32(t.point(desc.vertex_normals[i as usize].0)));
-                let n = v.map(|i| to_f32(t.normal(desc.vertex_normals[i as usize].1).normalize()));
-                vertex_normals.push(n);
-                Shape::Triangle {
-                    p,
-                    normals: Some(vertex_normals.len() as u32 - 1),
-                }
-            }
-        };
-        if let Shape::Triangle { p, normals } = &shape {
-            let n = (p[1] - p[0]).cross(p[2] - p[0]);
-            if !(n.length_squared() > 0.0) || !n.is_finite() {
-                // A sliver of a tessellated surface is an artefact of rounding, not a
-                // mistake in the scene: dropped without a word.
-                if !matches!(s.kind, ShapeKind::TessellatedTri { .. }) {
-                    diags.warning(s.loc, "degenerate triangle (zero area) skipped");
-                }
-                if normals.is_some() {
-                    vertex_normals.pop();
-                }
-                continue;
-            }
-        }
-        primitives.push(Primitive {
-            shape,
-            material: s.material,
-        });
-    }
+            let bounds = prims.iter().fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()));
+            Some((Arc::new(Geometry::new(prims, normals, options.accel)), bounds))
+        })
+        .collect();
+    let (primitives, vertex_normals) = build_primitives(desc, None, &objects, &view, diags);
 
     let mut lights = Vec::new();
     for l in &desc.lights {
@@ -168,6 +130,113 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         integrator: Box::new(Whitted { max_depth }),
         gamma: desc.gamma() as f32,
     })
+}
+
+/// What tessellation and mesh structures need to know about the render.
+struct View {
+    camera: CameraDesc,
+    height: u32,
+    accel: AccelKind,
+}
+
+/// The primitives of the scene (`object` `None`) or of one object, with the vertex
+/// normals their `trinormal` triangles index.
+fn build_primitives(
+    desc: &SceneDesc,
+    object: Option<u32>,
+    objects: &[Option<(Arc<Geometry>, Aabb)>],
+    view: &View,
+    diags: &mut Diagnostics,
+) -> (Vec<Primitive>, Vec<[Vec3A; 3]>) {
+    let mut primitives = Vec::new();
+    let mut vertex_normals = Vec::new();
+    for s in desc.shapes.iter().filter(|s| s.object == object) {
+        let t = &desc.transforms[s.transform as usize];
+        let shape = match s.kind {
+            ShapeKind::Sphere { center, radius } => {
+                let m = t.m * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
+                Shape::Sphere(Sphere::new(Transform::to_f32(&m)))
+            }
+            ShapeKind::Plane { .. }
+            | ShapeKind::Box { .. }
+            | ShapeKind::Cylinder { .. }
+            | ShapeKind::Disk { .. }
+            | ShapeKind::Cone { .. }
+            | ShapeKind::Quadric { .. } => {
+                Shape::Analytic(Box::new(Analytic::new(Transform::to_f32(&t.m), analytic_kind(&s.kind))))
+            }
+            ShapeKind::Triangle { v } => {
+                let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
+                Shape::Triangle { p, normals: None }
+            }
+            ShapeKind::TriNormal { v } => {
+                let p = v.map(|i| to_f32(t.point(desc.vertex_normals[i as usize].0)));
+                let n = v.map(|i| to_f32(t.normal(desc.vertex_normals[i as usize].1).normalize()));
+                vertex_normals.push(n);
+                Shape::Triangle {
+                    p,
+                    normals: Some(vertex_normals.len() as u32 - 1),
+                }
+            }
+            ShapeKind::Mesh { index } => {
+                let mesh = world_mesh(&desc.meshes[index as usize], t, s.material);
+                if mesh.indices.is_empty() {
+                    continue;
+                }
+                Shape::Mesh(MeshShape::new(mesh, view.accel))
+            }
+            ShapeKind::Nurbs { index } => {
+                let mut mesh = nurbs_mesh(&desc.nurbs[index as usize], t, view);
+                mesh.material = s.material;
+                if mesh.indices.is_empty() {
+                    continue;
+                }
+                Shape::Mesh(MeshShape::new(mesh, view.accel))
+            }
+            ShapeKind::Instance { object } => match &objects[object as usize] {
+                Some((geometry, bounds)) => Shape::Instance(Box::new(Instance::new(
+                    geometry.clone(),
+                    *bounds,
+                    Transform::to_f32(&t.m),
+                ))),
+                None => continue, // an empty object (objectend warned)
+            },
+        };
+        if let Shape::Triangle { p, normals } = &shape {
+            let n = (p[1] - p[0]).cross(p[2] - p[0]);
+            if !(n.length_squared() > 0.0) || !n.is_finite() {
+                diags.warning(s.loc, "degenerate triangle (zero area) skipped");
+                if normals.is_some() {
+                    vertex_normals.pop();
+                }
+                continue;
+            }
+        }
+        primitives.push(Primitive {
+            shape,
+            material: s.material,
+        });
+    }
+    (primitives, vertex_normals)
+}
+
+/// A mesh of the description moved to world space by `t`, with `material` where its
+/// triangles have none of their own. Triangles that rounding collapses are dropped.
+fn world_mesh(mesh: &TriangleMesh, t: &Transform, material: u32) -> TriangleMesh {
+    let mut out = TriangleMesh {
+        positions: mesh.positions.iter().map(|p| t.point(p.as_dvec3()).as_vec3()).collect(),
+        normals: mesh
+            .normals
+            .iter()
+            .map(|n| t.normal(n.as_dvec3()).normalize_or_zero().as_vec3())
+            .collect(),
+        uvs: mesh.uvs.clone(),
+        indices: mesh.indices.clone(),
+        materials: mesh.materials.clone(),
+        material,
+    };
+    out.remove_degenerate();
+    out
 }
 
 /// Global settings this version cannot honour are errors; settings that only other
@@ -248,7 +317,8 @@ fn analytic_kind(kind: &ShapeKind) -> AnalyticKind {
         ShapeKind::Sphere { .. }
         | ShapeKind::Triangle { .. }
         | ShapeKind::TriNormal { .. }
-        | ShapeKind::TessellatedTri { .. }
+        | ShapeKind::Mesh { .. }
+        | ShapeKind::Instance { .. }
         | ShapeKind::Nurbs { .. } => {
             unreachable!("not an analytic shape")
         }
@@ -256,17 +326,10 @@ fn analytic_kind(kind: &ShapeKind) -> AnalyticKind {
 }
 
 /// Tessellates a NURBS surface finely enough that no chord strays more than a quarter of
-/// a pixel from the surface where it is nearest to the camera, and adds the triangles,
-/// with normals from the exact derivatives.
-fn add_nurbs(
-    surface: &lucent_core::shape::nurbs::NurbsSurface,
-    t: &Transform,
-    material: u32,
-    camera: &crate::desc::CameraDesc,
-    height: u32,
-    primitives: &mut Vec<Primitive>,
-    vertex_normals: &mut Vec<[Vec3A; 3]>,
-) {
+/// a pixel from the surface where it is nearest to the camera, with normals from the
+/// exact derivatives, in world space.
+fn nurbs_mesh(surface: &lucent_core::shape::nurbs::NurbsSurface, t: &Transform, view: &View) -> TriangleMesh {
+    let camera = &view.camera;
     // With positive weights the surface lies in the hull of its control points.
     let corners: Vec<DVec3> = surface.points.iter().map(|p| t.point(p.truncate() / p.w)).collect();
     let (lo, hi) = corners
@@ -277,7 +340,7 @@ fn add_nurbs(
     let nearest = (camera.eye.clamp(lo, hi) - camera.eye)
         .length()
         .max(1e-3 * (hi - lo).length());
-    let pixel = 2.0 * nearest * (camera.fovy.to_radians() / 2.0).tan() / height as f64;
+    let pixel = 2.0 * nearest * (camera.fovy.to_radians() / 2.0).tan() / view.height as f64;
     // Object-space tolerance: divide by the largest stretch of the transform.
     let m = t.m.matrix3;
     let stretch = m
@@ -289,32 +352,10 @@ fn add_nurbs(
     let (nu, nv) = surface.segments_for(0.25 * pixel / stretch);
     // A bound on the triangles one surface may cost (half a million).
     let (nu, nv) = (nu.min(512), nv.min(512));
-    let grid = surface.tessellate(nu, nv);
-    for tri in lucent_core::shape::parametric::grid_triangles(nu, nv) {
-        let v = tri.map(|k| grid[k]);
-        let p = v.map(|(p, _)| to_f32(t.point(p)));
-        let area = (p[1] - p[0]).cross(p[2] - p[0]);
-        if !(area.length_squared() > 0.0) || !area.is_finite() {
-            continue; // collapsed at a pole
-        }
-        let n = v.map(|(_, n)| to_f32(t.normal(n).normalize()));
-        primitives.push(Primitive {
-            shape: smooth_triangle(p, n, vertex_normals),
-            material,
-        });
-    }
-}
-
-/// A triangle of a tessellated surface with its vertex normals; shaded flat where the
-/// surface had none (a fully degenerate patch gives non-finite normals).
-fn smooth_triangle(p: [Vec3A; 3], n: [Vec3A; 3], vertex_normals: &mut Vec<[Vec3A; 3]>) -> Shape {
-    if n.iter().all(|n| n.is_finite()) {
-        vertex_normals.push(n);
-        Shape::Triangle {
-            p,
-            normals: Some(vertex_normals.len() as u32 - 1),
-        }
-    } else {
-        Shape::Triangle { p, normals: None }
-    }
+    let grid: Vec<(Vec3, Vec3)> = surface
+        .tessellate(nu, nv)
+        .into_iter()
+        .map(|(p, n)| (t.point(p).as_vec3(), t.normal(n).as_vec3()))
+        .collect();
+    grid_mesh(&grid, nu, nv)
 }

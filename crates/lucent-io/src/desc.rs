@@ -86,8 +86,11 @@ pub enum ShapeKind {
     Disk { radius: f64 },
     /// `cone radius height`, `radius > 0`, `height ≠ 0`.
     Cone { radius: f64, height: f64 },
-    /// A triangle of a tessellated surface: indices into [`SceneDesc::tessellated`].
-    TessellatedTri { v: [u32; 3] },
+    /// A triangle mesh (`mesh`, `subdivmesh`, `bezierpatches`): index into
+    /// [`SceneDesc::meshes`].
+    Mesh { index: u32 },
+    /// `instance name`: index into [`SceneDesc::objects`].
+    Instance { object: u32 },
     /// A NURBS surface: index into [`SceneDesc::nurbs`].
     Nurbs { index: u32 },
     /// `quadric a … j x0 y0 z0 x1 y1 z1`: coefficients (not all zero) and the clip box.
@@ -105,6 +108,17 @@ pub struct ShapeDesc {
     pub transform: u32,
     /// Index into [`SceneDesc::materials`]: the material current at the command.
     pub material: u32,
+    /// The object (`objectbegin` … `objectend`) the shape belongs to; `None` for the
+    /// scene itself.
+    pub object: Option<u32>,
+    pub loc: Loc,
+}
+
+/// A named object: the shapes whose `object` is its index.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectDesc {
+    pub name: String,
+    /// The `objectbegin` command.
     pub loc: Loc,
 }
 
@@ -170,9 +184,11 @@ pub struct SceneDesc {
     pub vertices: Vec<DVec3>,
     /// The `vertexnormal` pile: position and normal, untransformed.
     pub vertex_normals: Vec<(DVec3, DVec3)>,
-    /// Points and unit normals of tessellated surfaces (`bezierpatches`), in object space:
-    /// a pile of its own, so that the `vertexnormal` numbering stays the scene's.
-    pub tessellated: Vec<(DVec3, DVec3)>,
+    /// Triangle meshes in object space. Per-triangle materials, when present, are
+    /// indices into `materials` (from an OBJ file's MTL library); otherwise the mesh
+    /// takes the material its shape captured.
+    pub meshes: Vec<lucent_core::mesh::TriangleMesh>,
+    pub objects: Vec<ObjectDesc>,
     /// NURBS surfaces (`nurbs` with its `knotsu`, `knotsv` and `cpoint` lines), in object
     /// space; tessellated when the scene is built, when the camera says how fine.
     pub nurbs: Vec<lucent_core::shape::nurbs::NurbsSurface>,

@@ -40,3 +40,13 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
         _ => Err("unknown mesh format (expected a .obj or .ply file)".into()),
     }
 }
+
+/// Loads the polygons of an OBJ or PLY file, untriangulated (for `subdivmesh`).
+pub fn load_polygons(path: &Path) -> Result<lucent_core::shape::subdivision::ControlMesh, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("obj") => crate::obj::load_obj_polygons(path),
+        Some("ply") => crate::ply::load_ply_polygons(path),
+        _ => Err("unknown mesh format (expected a .obj or .ply file)".into()),
+    }
+}

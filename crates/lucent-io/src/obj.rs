@@ -9,7 +9,8 @@
 use std::path::Path;
 
 use crate::mesh_file::{LoadedMesh, MeshMaterial, NO_MATERIAL};
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
+use lucent_core::shape::subdivision::ControlMesh;
 
 pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     let options = tobj::LoadOptions {
@@ -92,6 +93,51 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
         mesh.materials.clear();
     }
     mesh.check()?;
+    Ok(out)
+}
+
+/// The polygons of an OBJ file as they are, on shared positions (for subdivision):
+/// texture coordinates and normals are left out, since subdivision makes its own.
+pub fn load_obj_polygons(path: &Path) -> Result<ControlMesh, String> {
+    let options = tobj::LoadOptions {
+        triangulate: false,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _) = tobj::load_obj(path, &options).map_err(|e| format!("cannot read OBJ mesh: {e}"))?;
+    let mut out = ControlMesh::default();
+    for model in &models {
+        let m = &model.mesh;
+        let base = out.positions.len() as u32;
+        let count = m.positions.len() / 3;
+        out.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
+        );
+        // No arities means every face is a triangle.
+        let arities: Vec<usize> = if m.face_arities.is_empty() {
+            vec![3; m.indices.len() / 3]
+        } else {
+            m.face_arities.iter().map(|&a| a as usize).collect()
+        };
+        let mut at = 0;
+        for (k, &n) in arities.iter().enumerate() {
+            let face = m.indices.get(at..at + n).ok_or("face list shorter than its sizes")?;
+            if face.iter().any(|&i| i as usize >= count) {
+                return Err(format!(
+                    "face {k} of object '{}' refers to a vertex that does not exist",
+                    model.name
+                ));
+            }
+            out.faces.push(face.iter().map(|&i| base + i).collect());
+            at += n;
+        }
+    }
+    if let Some(p) = out.positions.iter().find(|p| !p.is_finite()) {
+        return Err(format!("vertex {p} is not a finite number"));
+    }
     Ok(out)
 }
 

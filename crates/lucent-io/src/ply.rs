@@ -9,8 +9,9 @@
 use std::io::BufReader;
 use std::path::Path;
 
-use glam::{Vec2, Vec3};
+use glam::{DVec3, Vec2, Vec3};
 use lucent_core::mesh::TriangleMesh;
+use lucent_core::shape::subdivision::ControlMesh;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property, PropertyAccess};
 
@@ -98,7 +99,9 @@ impl PropertyAccess for Face {
     }
 }
 
-pub fn load_ply(path: &Path) -> Result<LoadedMesh, String> {
+/// The vertices and faces of a PLY file, faces checked (at least three corners, every
+/// index a vertex).
+fn read_ply(path: &Path) -> Result<(Vec<Vertex>, Vec<Face>), String> {
     let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {}", crate::cse167::io_reason(&e)))?;
     let mut reader = BufReader::new(file);
     let bad = |e: std::io::Error| format!("malformed PLY file: {e}");
@@ -134,6 +137,38 @@ pub fn load_ply(path: &Path) -> Result<LoadedMesh, String> {
     let vertices = vertices.ok_or("the PLY file has no 'vertex' element")?;
     let faces = faces.ok_or("the PLY file has no 'face' element")?;
 
+    let n = vertices.len() as i64;
+    for (k, f) in faces.iter().enumerate() {
+        if let Some(name) = &f.bad {
+            return Err(format!("face {k}: property '{name}' is not a list of integers"));
+        }
+        if f.indices.len() < 3 {
+            return Err(format!("face {k} has {} vertices (at least 3 needed)", f.indices.len()));
+        }
+        if let Some(&i) = f.indices.iter().find(|&&i| i < 0 || i >= n) {
+            return Err(format!("face {k} refers to vertex {i} but the file has {n} vertices"));
+        }
+    }
+    if let Some(k) = vertices.iter().position(|v| v.p.iter().any(|c| !c.is_finite())) {
+        return Err(format!("vertex {k} has no finite x, y and z"));
+    }
+    Ok((vertices, faces))
+}
+
+/// The polygons of a PLY file as they are (for subdivision).
+pub fn load_ply_polygons(path: &Path) -> Result<ControlMesh, String> {
+    let (vertices, faces) = read_ply(path)?;
+    Ok(ControlMesh {
+        positions: vertices.iter().map(|v| DVec3::from_array(v.p)).collect(),
+        faces: faces
+            .into_iter()
+            .map(|f| f.indices.into_iter().map(|i| i as u32).collect())
+            .collect(),
+    })
+}
+
+pub fn load_ply(path: &Path) -> Result<LoadedMesh, String> {
+    let (vertices, faces) = read_ply(path)?;
     let mut mesh = TriangleMesh::default();
     for (k, v) in vertices.iter().enumerate() {
         if v.p.iter().any(|c| !c.is_finite()) {
@@ -154,17 +189,7 @@ pub fn load_ply(path: &Path) -> Result<LoadedMesh, String> {
             .map(|v| Vec2::new(v.uv[0] as f32, v.uv[1] as f32))
             .collect();
     }
-    let n = mesh.positions.len() as i64;
-    for (k, f) in faces.iter().enumerate() {
-        if let Some(name) = &f.bad {
-            return Err(format!("face {k}: property '{name}' is not a list of integers"));
-        }
-        if f.indices.len() < 3 {
-            return Err(format!("face {k} has {} vertices (at least 3 needed)", f.indices.len()));
-        }
-        if let Some(&i) = f.indices.iter().find(|&&i| i < 0 || i >= n) {
-            return Err(format!("face {k} refers to vertex {i} but the file has {n} vertices"));
-        }
+    for f in &faces {
         for j in 1..f.indices.len() - 1 {
             mesh.indices
                 .push([f.indices[0], f.indices[j], f.indices[j + 1]].map(|i| i as u32));

@@ -274,8 +274,8 @@ fn unknown_commands_warn_or_fail_in_strict_mode() {
 #[test]
 fn unsupported_features_are_errors_not_silent_differences() {
     assert_eq!(
-        first_error("mesh dragon.obj"),
-        "t.test:3:1: error: mesh: this lucent extension (docs/scene-format.md) is not implemented yet"
+        first_error("glossy 20 4"),
+        "t.test:3:1: error: glossy: this lucent extension (docs/scene-format.md) is not implemented yet"
     );
     assert_eq!(
         first_error("integrator pathtracer"),
@@ -433,10 +433,13 @@ fn the_shipped_teapot_scene_tessellates() {
         "{}",
         diags.render(&desc.sources)
     );
-    let tris = desc.shapes.len() - 1; // and the floor plane
+    assert_eq!(desc.shapes.len(), 2, "one mesh and the floor plane");
+    let mesh = &desc.meshes[0];
+    let tris = mesh.indices.len();
     assert!((16_000..=16_384).contains(&tris), "{tris}");
-    assert_eq!(desc.tessellated.len(), 32 * 17 * 17);
-    assert!(desc.tessellated.iter().all(|(_, n)| (n.length() - 1.0).abs() < 1e-9));
+    assert_eq!(mesh.positions.len(), 32 * 17 * 17);
+    assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-6));
+    assert_eq!(mesh.uvs.len(), mesh.positions.len());
 }
 
 #[test]

@@ -72,10 +72,9 @@ pub fn run(args: &CheckArgs) -> u8 {
         ("cone", count(&|k| matches!(k, ShapeKind::Cone { .. }))),
         ("quadric", count(&|k| matches!(k, ShapeKind::Quadric { .. }))),
         ("nurbs surface", count(&|k| matches!(k, ShapeKind::Nurbs { .. }))),
-        (
-            "patch triangle",
-            count(&|k| matches!(k, ShapeKind::TessellatedTri { .. })),
-        ),
+        ("mesh", count(&|k| matches!(k, ShapeKind::Mesh { .. }))),
+        ("object", desc.objects.len()),
+        ("instance", count(&|k| matches!(k, ShapeKind::Instance { .. }))),
     ]
     .into_iter()
     .filter(|&(_, n)| n > 0)

@@ -11,26 +11,28 @@ pub struct Mailbox {
 }
 
 thread_local! {
-    static MAILBOX: RefCell<Mailbox> = RefCell::new(Mailbox::default());
+    /// A pool rather than one mailbox: structures nest (a grid of meshes, each with a
+    /// grid of its own), and each level of a query needs its own stamps.
+    static MAILBOXES: RefCell<Vec<Mailbox>> = const { RefCell::new(Vec::new()) };
 }
 
 impl Mailbox {
-    /// Runs `f` with this thread's mailbox, emptied for a new query over `prim_count`
+    /// Runs `f` with a mailbox of this thread, emptied for a new query over `prim_count`
     /// primitives.
     pub fn with<R>(prim_count: usize, f: impl FnOnce(&mut Mailbox) -> R) -> R {
-        MAILBOX.with(|m| {
-            let mut m = m.borrow_mut();
-            if m.stamps.len() < prim_count {
-                m.stamps.resize(prim_count, 0);
-            }
-            m.query = m.query.wrapping_add(1);
-            if m.query == 0 {
-                // After 2³² queries the stamps would repeat: start afresh.
-                m.stamps.fill(0);
-                m.query = 1;
-            }
-            f(&mut m)
-        })
+        let mut m = MAILBOXES.with(|pool| pool.borrow_mut().pop()).unwrap_or_default();
+        if m.stamps.len() < prim_count {
+            m.stamps.resize(prim_count, 0);
+        }
+        m.query = m.query.wrapping_add(1);
+        if m.query == 0 {
+            // After 2³² queries the stamps would repeat: start afresh.
+            m.stamps.fill(0);
+            m.query = 1;
+        }
+        let r = f(&mut m);
+        MAILBOXES.with(|pool| pool.borrow_mut().push(m));
+        r
     }
 
     /// True the first time a primitive is seen in this query.
@@ -57,5 +59,11 @@ mod tests {
         Mailbox::with(10, |m| assert!(m.first_visit(3)));
         // A later query over more primitives grows the stamps.
         Mailbox::with(100, |m| assert!(m.first_visit(99)));
+        // Queries nest (structures inside structures), each with its own stamps.
+        Mailbox::with(10, |outer| {
+            assert!(outer.first_visit(5));
+            Mailbox::with(10, |inner| assert!(inner.first_visit(5)));
+            assert!(!outer.first_visit(5));
+        });
     }
 }

@@ -13,5 +13,6 @@ pub mod plane;
 pub mod quadratic;
 pub mod quadric;
 pub mod sphere;
+pub mod subdivision;
 pub mod texcoord;
 pub mod triangle;

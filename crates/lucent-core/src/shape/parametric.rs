@@ -1,7 +1,8 @@
 //! What the parametric surfaces (Bézier patches, NURBS) share: the normal where the
 //! derivatives may vanish, and the triangles of a tessellation grid.
 
-use glam::DVec3;
+use crate::mesh::TriangleMesh;
+use glam::{DVec3, Vec2, Vec3};
 
 /// The unit normal `S_u × S_v` at `(u, v)`, from `derivatives(u, v) = (S_u, S_v)`.
 /// Where it vanishes — at a pole, where a whole row of control points collapses into one —
@@ -35,6 +36,25 @@ pub fn grid_triangles(columns: usize, rows: usize) -> impl Iterator<Item = [usiz
             ]
         })
     })
+}
+
+/// A triangle mesh from a grid of `(columns + 1) × (rows + 1)` points with their normals
+/// (row by row, as [`grid_triangles`] numbers them); texture coordinates run from 0 to 1
+/// across the grid. Triangles collapsed at a pole are dropped; a zero normal (where the
+/// surface has none) makes its triangles shade flat.
+pub fn grid_mesh(points: &[(Vec3, Vec3)], columns: usize, rows: usize) -> TriangleMesh {
+    debug_assert_eq!(points.len(), (columns + 1) * (rows + 1));
+    let mut mesh = TriangleMesh {
+        positions: points.iter().map(|p| p.0).collect(),
+        normals: points.iter().map(|p| p.1.normalize_or_zero()).collect(),
+        uvs: (0..=rows)
+            .flat_map(|i| (0..=columns).map(move |j| Vec2::new(j as f32 / columns as f32, i as f32 / rows as f32)))
+            .collect(),
+        indices: grid_triangles(columns, rows).map(|t| t.map(|k| k as u32)).collect(),
+        ..TriangleMesh::default()
+    };
+    mesh.remove_degenerate();
+    mesh
 }
 
 #[cfg(test)]

@@ -7,9 +7,10 @@
 //! ranges, indices — and records it with its location. It does not build geometry.
 //! docs/scene-format.md lists every command with its arguments, defaults and errors.
 
-use std::path::Path;
+mod meshes;
+mod objects;
 
-use lucent_core::shape::parametric::grid_triangles;
+use std::path::Path;
 
 use glam::DVec3;
 use lucent_core::camera::{Camera, CameraError};
@@ -43,6 +44,15 @@ const COMMANDS: &[&str] = &[
     "cone",
     "quadric",
     "bezierpatches",
+    "mesh",
+    "subdivmesh",
+    "nurbs",
+    "knotsu",
+    "knotsv",
+    "cpoint",
+    "objectbegin",
+    "objectend",
+    "instance",
     "maxverts",
     "maxvertnorms",
     "vertex",
@@ -78,15 +88,6 @@ const COMMANDS: &[&str] = &[
 /// Commands of lucent's extensions (`../shared/EXTENSIONS.md`) that this version does not
 /// implement yet. Using one is an error, never a silently different picture.
 const NOT_YET_IMPLEMENTED: &[&str] = &[
-    "mesh",
-    "subdivmesh",
-    "nurbs",
-    "knotsu",
-    "knotsv",
-    "cpoint",
-    "objectbegin",
-    "objectend",
-    "instance",
     "transparent",
     "ior",
     "texture",
@@ -211,6 +212,9 @@ struct Parser {
     warned_vert_norms: bool,
     seen_command: bool,
     push_lines: Vec<u32>,
+    /// The object being recorded (`objectbegin` without its `objectend` yet), with the
+    /// line of its `objectbegin`.
+    object: Option<(u32, u32)>,
 }
 
 impl Parser {
@@ -234,6 +238,7 @@ impl Parser {
             warned_vert_norms: false,
             seen_command: false,
             push_lines: Vec::new(),
+            object: None,
         }
     }
 
@@ -332,6 +337,11 @@ impl Parser {
         }
         match c.name.text {
             "nurbs" => self.nurbs_header(c),
+            "mesh" => self.mesh(c),
+            "subdivmesh" => self.subdiv_mesh(c),
+            "objectbegin" => self.object_begin(c),
+            "objectend" => self.object_end(c),
+            "instance" => self.instance(c),
             "knotsu" | "knotsv" | "cpoint" => self.nurbs_part(c),
             "size" => self.size(c),
             "maxdepth" => {
@@ -823,75 +833,6 @@ impl Parser {
         self.shape(c, kind);
     }
 
-    /// `bezierpatches file [divisions]`: the patches of `file`, each tessellated into
-    /// `divisions × divisions` quads (two triangles each) with normals from the exact
-    /// derivatives, under the current transform and material.
-    fn bezier_patches(&mut self, c: &Command) {
-        if c.args.is_empty() || c.args.len() > 2 {
-            let n = c.args.len();
-            self.err_cmd(
-                c,
-                format!("bezierpatches: expected a file name and optionally a number of divisions, got {n} arguments"),
-            );
-            return;
-        }
-        let divisions = match c.args.get(1) {
-            None => 16,
-            Some(tok) => match self.integer(c, tok) {
-                Some(d) if (1..=256).contains(&d) => d as u32,
-                Some(d) => {
-                    self.err_arg(
-                        c,
-                        1,
-                        format!("bezierpatches: divisions must be between 1 and 256, got {d}"),
-                    );
-                    return;
-                }
-                None => return,
-            },
-        };
-        let name = c.args[0].text.to_string();
-        let path = self.base_dir.join(&name);
-        let text = match std::fs::read(&path) {
-            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
-            Err(e) => {
-                self.err_arg(
-                    c,
-                    0,
-                    format!("bezierpatches: cannot read '{}': {}", path.display(), io_reason(&e)),
-                );
-                return;
-            }
-        };
-        let patches = match crate::patches::parse_patches(&text) {
-            Ok(p) => p,
-            Err(e) => {
-                let at = if e.line > 0 {
-                    format!(":{}", e.line)
-                } else {
-                    String::new()
-                };
-                self.err_arg(c, 0, format!("bezierpatches: {}{at}: {}", path.display(), e.message));
-                return;
-            }
-        };
-        let n = divisions as usize + 1;
-        for patch in &patches.patches {
-            let base = self.desc.tessellated.len() as u32;
-            self.desc
-                .tessellated
-                .extend(lucent_core::shape::bezier::tessellate(patch, divisions));
-            for tri in grid_triangles(n - 1, n - 1) {
-                let v = tri.map(|k| base + k as u32);
-                // Quads at a pole have a collapsed edge: drop their empty triangles.
-                let p = v.map(|k| self.desc.tessellated[k as usize].0);
-                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() > 0.0 {
-                    self.shape(c, ShapeKind::TessellatedTri { v });
-                }
-            }
-        }
-    }
-
     /// `nurbs du dv nu nv`: degrees and control point counts; the knots and control
     /// points follow on their own lines.
     fn nurbs_header(&mut self, c: &Command) {
@@ -1030,6 +971,7 @@ impl Parser {
                 kind: ShapeKind::Nurbs { index },
                 transform: p.transform,
                 material: p.material,
+                object: self.object.map(|(o, _)| o),
                 loc: p.at,
             });
         } else {
@@ -1097,6 +1039,7 @@ impl Parser {
             kind,
             transform,
             material,
+            object: self.object.map(|(o, _)| o),
             loc,
         });
     }
@@ -1110,6 +1053,17 @@ impl Parser {
     }
 
     fn light(&mut self, c: &Command, kind: LightKind) {
+        if let Some((o, line)) = self.object {
+            let name = &self.desc.objects[o as usize].name;
+            self.err_cmd(
+                c,
+                format!(
+                    "{}: lights cannot be part of an object (object '{name}' begun on line {line} is still open)",
+                    c.name.text
+                ),
+            );
+            return;
+        }
         if !self.current.is_identity() {
             self.warn_cmd(c, format!("{}: the light is transformed by the current transform (the course's renderers ignore transforms on lights)", c.name.text));
         }
@@ -1138,6 +1092,7 @@ impl Parser {
     }
 
     fn finish(&mut self, lines: u32) {
+        self.unclosed_object();
         if let Some(p) = self.nurbs.take() {
             let wanted = Self::nurbs_expects(&p.surface);
             self.diags.error(
@@ -1311,25 +1266,35 @@ impl Parser {
     }
 
     fn keyword<T: Copy>(&mut self, c: &Command, options: &[(&str, T)]) -> Option<T> {
-        let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
-        let list = match names.as_slice() {
-            [a, b] => format!("{a} or {b}"),
-            [init @ .., last] => format!("{} or {last}", init.join(", ")),
-            [] => String::new(),
-        };
-        if !self.expect_count(c, 1, &format!("one of {list}")) {
+        if !self.expect_count(c, 1, &format!("one of {}", Self::alternatives(options))) {
             return None;
         }
-        let tok = &c.args[0];
+        self.keyword_at(c, 0, options)
+    }
+
+    /// Argument `k` as one of the names in `options`.
+    fn keyword_at<T: Copy>(&mut self, c: &Command, k: usize, options: &[(&str, T)]) -> Option<T> {
+        let tok = &c.args[k];
         let found = options.iter().find(|(n, _)| *n == tok.text).map(|(_, v)| *v);
         if found.is_none() {
             let loc = self.loc(c.line, tok);
+            let list = Self::alternatives(options);
             self.diags.error(
                 loc,
                 format!("{}: unknown value '{}' (expected {list})", c.name.text, tok.text),
             );
         }
         found
+    }
+
+    /// "a, b or c".
+    fn alternatives<T>(options: &[(&str, T)]) -> String {
+        let names: Vec<&str> = options.iter().map(|(n, _)| *n).collect();
+        match names.as_slice() {
+            [a, b] => format!("{a} or {b}"),
+            [init @ .., last] => format!("{} or {last}", init.join(", ")),
+            [] => String::new(),
+        }
     }
 
     /// A colour from three parsed numbers starting at argument `first`; negative
