@@ -5,7 +5,7 @@
 use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_bytes, ParseOptions};
 
-const SEED_SCENE: &str = "size 16 12\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 3\nattenuation 1 0.1 0.01\npoint 1 2 3 1 1 1\ndirectional 0 1 1 .5 .5 .5\nmaxverts 4\nvertex -1 -1 0\nvertex 1 -1 0\nvertex 1 1 0\nvertexnormal 0 0 0 0 0 1\nvertexnormal 1 0 0 0 1 1\nvertexnormal 0 1 0 1 0 1\ndiffuse 0.5 0.2 0.1\nspecular .3 .3 .3\nshininess 20\npushTransform\nrotate 0 1 0 30\nscale 1 2 0.5\nsphere 0 0 0 1\ntri 0 1 2\ntrinormal 0 1 2\npopTransform\nplane 0 -1 0 0 1 0\nbox -1 -1 -1 1 1 1\ncylinder 1 -1 1\ndisk 1\ncone 1 2\nquadric 1 1 -1 0 0 0 0 0 0 -0.1 -1 -1 -1 1 1 1\nnurbs 2 1 3 2\nknotsu 0 0 0 1 1 1\nknotsv 0 0 1 1\ncpoint 0 0 0 1\ncpoint 1 0 1 .7\ncpoint 2 0 0 1\ncpoint 0 1 0 1\ncpoint 1 1 1 .7\ncpoint 2 1 0 1\nintegrator raytracer\ngamma 2.2\n";
+const SEED_SCENE: &str = "size 16 12\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 3\nattenuation 1 0.1 0.01\npoint 1 2 3 1 1 1\ndirectional 0 1 1 .5 .5 .5\nmaxverts 4\nvertex -1 -1 0\nvertex 1 -1 0\nvertex 1 1 0\nvertexnormal 0 0 0 0 0 1\nvertexnormal 1 0 0 0 1 1\nvertexnormal 0 1 0 1 0 1\ndiffuse 0.5 0.2 0.1\nspecular .3 .3 .3\nshininess 20\npushTransform\nrotate 0 1 0 30\nscale 1 2 0.5\nsphere 0 0 0 1\ntri 0 1 2\ntrinormal 0 1 2\npopTransform\nplane 0 -1 0 0 1 0\nbox -1 -1 -1 1 1 1\ncylinder 1 -1 1\ndisk 1\ncone 1 2\nquadric 1 1 -1 0 0 0 0 0 0 -0.1 -1 -1 -1 1 1 1\nnurbs 2 1 3 2\nknotsu 0 0 0 1 1 1\nknotsv 0 0 1 1\ncpoint 0 0 0 1\ncpoint 1 0 1 .7\ncpoint 2 0 0 1\ncpoint 0 1 0 1\ncpoint 1 1 1 .7\ncpoint 2 1 0 1\nobjectbegin thing\nsphere 0 0 0 1\ntri 0 1 2\nobjectend\npushTransform\ntranslate 1 0 0\ninstance thing\npopTransform\nintegrator raytracer\ngamma 2.2\n";
 
 struct Rng(u64);
 impl Rng {
@@ -37,6 +37,10 @@ const INTERESTING: &[&str] = &[
     "\t",
     "popTransform",
     "pushTransform",
+    "objectbegin",
+    "objectend",
+    "instance",
+    "thing",
     "tri",
     "sphere",
     "plane",
@@ -59,7 +63,7 @@ const INTERESTING: &[&str] = &[
 fn random_mutations_never_panic() {
     let (seed, seed_diags) = parse_bytes("seed.test", SEED_SCENE.as_bytes(), ParseOptions { strict: true });
     assert!(
-        !seed_diags.has_errors() && seed.shapes.len() == 10,
+        !seed_diags.has_errors() && seed.shapes.len() == 13,
         "{}",
         seed_diags.render(&seed.sources)
     );

@@ -1,0 +1,24 @@
+//! Any bytes as an OBJ or PLY file (the first byte picks the format): the mesh loaders,
+//! the polygon loaders and subdivision must return a mesh or an error, never panic.
+//! Run with `cargo +nightly fuzz run mesh_files` from this folder.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use lucent_core::shape::subdivision::{subdivide, Scheme};
+use lucent_io::mesh_file::{load_mesh, load_polygons};
+
+fuzz_target!(|data: &[u8]| {
+    let Some((&kind, body)) = data.split_first() else {
+        return;
+    };
+    let ext = if kind & 1 == 0 { "obj" } else { "ply" };
+    let path = std::env::temp_dir().join(format!("lucent-fuzz-{}.{ext}", std::process::id()));
+    std::fs::write(&path, body).expect("temp file");
+    let _ = load_mesh(&path);
+    if let Ok(control) = load_polygons(&path) {
+        if control.faces.len() < 64 {
+            let scheme = if kind & 2 == 0 { Scheme::Loop } else { Scheme::CatmullClark };
+            let _ = subdivide(&control, scheme, 2);
+        }
+    }
+});
