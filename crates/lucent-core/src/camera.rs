@@ -1,10 +1,21 @@
-//! Scene command: `camera ex ey ez cx cy cz ux uy uz fovy` — a pinhole camera at E
+//! Scene commands: `camera ex ey ez cx cy cz ux uy uz fovy` — a pinhole camera at E
 //! looking at C, with up hint U and the full vertical field of view in degrees
-//! (SCENE_FORMAT.md §3.2). The frame is `w = normalize(E − C)`, `u = normalize(U × w)`,
-//! `v = w × u`; row 0 of the image is the top.
+//! (SCENE_FORMAT.md §3.2); `orthocamera … height` — parallel rays over a view `height`
+//! world units tall; `lens aperture focus` — a thin lens of radius `aperture` focused at
+//! distance `focus` (depth of field) for the perspective camera. The frame is
+//! `w = normalize(E − C)`, `u = normalize(U × w)`, `v = w × u`; row 0 of the image is the
+//! top.
 
 use crate::math::{DVec3, Vec3A};
 use crate::ray::Ray;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Full vertical field of view in degrees.
+    Perspective { fovy: f64 },
+    /// World-space height of the view.
+    Orthographic { height: f64 },
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
@@ -12,7 +23,12 @@ pub struct Camera {
     u: DVec3,
     v: DVec3,
     w: DVec3,
-    tan_half_fovy: f64,
+    /// Half the view's height: at unit distance (perspective) or in world units
+    /// (orthographic).
+    half_height: f64,
+    orthographic: bool,
+    /// Thin lens: radius and focus distance.
+    lens: Option<(f64, f64)>,
     width: f64,
     height: f64,
 }
@@ -21,11 +37,14 @@ pub struct Camera {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CameraError {
     FovOutOfRange,
+    /// An orthographic view height that is not positive.
+    HeightNotPositive,
     EyeAtTarget,
     UpParallelToView,
 }
 
 impl Camera {
+    /// A pinhole camera.
     pub fn look_at(
         eye: DVec3,
         center: DVec3,
@@ -34,9 +53,38 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Camera, CameraError> {
-        if !(fovy_degrees > 0.0 && fovy_degrees < 180.0) {
-            return Err(CameraError::FovOutOfRange);
-        }
+        Camera::new(
+            eye,
+            center,
+            up,
+            Projection::Perspective { fovy: fovy_degrees },
+            width,
+            height,
+        )
+    }
+
+    pub fn new(
+        eye: DVec3,
+        center: DVec3,
+        up: DVec3,
+        projection: Projection,
+        width: u32,
+        height: u32,
+    ) -> Result<Camera, CameraError> {
+        let (half_height, orthographic) = match projection {
+            Projection::Perspective { fovy } => {
+                if !(fovy > 0.0 && fovy < 180.0) {
+                    return Err(CameraError::FovOutOfRange);
+                }
+                ((fovy.to_radians() * 0.5).tan(), false)
+            }
+            Projection::Orthographic { height } => {
+                if !(height > 0.0 && height.is_finite()) {
+                    return Err(CameraError::HeightNotPositive);
+                }
+                (0.5 * height, true)
+            }
+        };
         let view = eye - center;
         if view.length() == 0.0 {
             return Err(CameraError::EyeAtTarget);
@@ -53,23 +101,68 @@ impl Camera {
             u,
             v,
             w,
-            tan_half_fovy: (fovy_degrees.to_radians() * 0.5).tan(),
+            half_height,
+            orthographic,
+            lens: None,
             width: width as f64,
             height: height as f64,
         })
     }
 
+    /// Adds a thin lens of radius `aperture` focused at distance `focus` (perspective
+    /// cameras only; an aperture of 0 is the pinhole).
+    pub fn with_lens(mut self, aperture: f64, focus: f64) -> Camera {
+        debug_assert!(!self.orthographic && aperture >= 0.0 && focus > 0.0);
+        self.lens = (aperture > 0.0).then_some((aperture, focus));
+        self
+    }
+
+    /// Whether rays need lens samples (see [`Camera::ray`]).
+    pub fn has_lens(&self) -> bool {
+        self.lens.is_some()
+    }
+
     /// The ray through the image point (`x`, `y`) in pixel units: column `j` and row `i`
-    /// have their centre at `(j + 0.5, i + 0.5)`.
-    pub fn ray(&self, x: f64, y: f64) -> Ray {
-        let a = self.tan_half_fovy * (self.width / self.height) * (2.0 * x / self.width - 1.0);
-        let b = self.tan_half_fovy * (1.0 - 2.0 * y / self.height);
-        let d = (self.u * a + self.v * b - self.w).normalize();
+    /// have their centre at `(j + 0.5, i + 0.5)`. `lens` is a point of the unit square
+    /// that picks the point of the lens the ray leaves from (ignored without a lens).
+    pub fn ray(&self, x: f64, y: f64, lens: (f32, f32)) -> Ray {
+        let a = self.half_height * (self.width / self.height) * (2.0 * x / self.width - 1.0);
+        let b = self.half_height * (1.0 - 2.0 * y / self.height);
+        let (origin, dir) = if self.orthographic {
+            (self.eye + self.u * a + self.v * b, -self.w)
+        } else {
+            let d = (self.u * a + self.v * b - self.w).normalize();
+            match self.lens {
+                None => (self.eye, d),
+                Some((aperture, focus)) => {
+                    // Every ray through the lens meets the pinhole ray on the plane of focus.
+                    let focal_point = self.eye + d * (focus / d.dot(-self.w));
+                    let (lx, ly) = concentric_disk(lens.0 as f64, lens.1 as f64);
+                    let origin = self.eye + (self.u * lx + self.v * ly) * aperture;
+                    (origin, (focal_point - origin).normalize())
+                }
+            }
+        };
         Ray::new(
-            Vec3A::new(self.eye.x as f32, self.eye.y as f32, self.eye.z as f32),
-            Vec3A::new(d.x as f32, d.y as f32, d.z as f32),
+            Vec3A::new(origin.x as f32, origin.y as f32, origin.z as f32),
+            Vec3A::new(dir.x as f32, dir.y as f32, dir.z as f32),
         )
     }
+}
+
+/// Shirley and Chiu's concentric map from the unit square to the unit disk: uniform, and
+/// strata of the square stay compact on the disk.
+pub fn concentric_disk(u: f64, v: f64) -> (f64, f64) {
+    let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a.abs() > b.abs() {
+        (a, std::f64::consts::FRAC_PI_4 * (b / a))
+    } else {
+        (b, std::f64::consts::FRAC_PI_2 - std::f64::consts::FRAC_PI_4 * (a / b))
+    };
+    (r * phi.cos(), r * phi.sin())
 }
 
 #[cfg(test)]
@@ -79,12 +172,12 @@ mod tests {
     #[test]
     fn centre_ray_looks_at_the_target_and_corners_span_the_fov() {
         let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 90.0, 200, 100).unwrap();
-        let r = c.ray(100.0, 50.0);
+        let r = c.ray(100.0, 50.0, (0.5, 0.5));
         assert!((r.dir - Vec3A::new(0.0, 0.0, -1.0)).length() < 1e-7);
         // Top edge at 45°; right edge at atan(2) because tan(fovx/2) = tan(fovy/2)·W/H.
-        let top = c.ray(100.0, 0.0).dir;
+        let top = c.ray(100.0, 0.0, (0.5, 0.5)).dir;
         assert!((top.y / -top.z - 1.0).abs() < 1e-6);
-        let right = c.ray(200.0, 50.0).dir;
+        let right = c.ray(200.0, 50.0, (0.5, 0.5)).dir;
         assert!((right.x / -right.z - 2.0).abs() < 1e-6);
     }
 
@@ -99,8 +192,43 @@ mod tests {
             48,
         )
         .unwrap();
-        let up = c.ray(32.0, 0.0).dir - c.ray(32.0, 48.0).dir;
+        let up = c.ray(32.0, 0.0, (0.5, 0.5)).dir - c.ray(32.0, 48.0, (0.5, 0.5)).dir;
         assert!(up.y > 0.0 && up.z > 0.0);
+    }
+
+    #[test]
+    fn orthographic_rays_are_parallel_and_span_the_height() {
+        let ortho = Projection::Orthographic { height: 4.0 };
+        let c = Camera::new(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, ortho, 200, 100).unwrap();
+        let top = c.ray(100.0, 0.0, (0.5, 0.5));
+        let corner = c.ray(200.0, 100.0, (0.5, 0.5));
+        assert_eq!(top.dir, Vec3A::new(0.0, 0.0, -1.0));
+        assert_eq!(corner.dir, top.dir);
+        assert!((top.origin - Vec3A::new(0.0, 2.0, 5.0)).length() < 1e-6);
+        assert!((corner.origin - Vec3A::new(4.0, -2.0, 5.0)).length() < 1e-6);
+    }
+
+    #[test]
+    fn lens_rays_meet_on_the_plane_of_focus() {
+        let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 60.0, 64, 48)
+            .unwrap()
+            .with_lens(0.5, 4.0);
+        let pinhole = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 60.0, 64, 48).unwrap();
+        let p = pinhole.ray(10.0, 7.0, (0.5, 0.5));
+        let focus = p.at(4.0 / -p.dir.z);
+        for lens in [(0.0, 0.0), (0.9, 0.2), (0.3, 0.99)] {
+            let r = c.ray(10.0, 7.0, lens);
+            assert!((r.origin.z - 5.0).abs() < 1e-6 && r.origin.truncate().length() <= 0.5 + 1e-6);
+            let at = r.at((focus.z - r.origin.z) / r.dir.z);
+            assert!((at - focus).length() < 1e-4, "{at} vs {focus}");
+        }
+        // Uniform on the disk: the mean radius² of a grid of samples is 1/2.
+        let mut sum = 0.0;
+        for i in 0..100 {
+            let (x, y) = concentric_disk((i % 10) as f64 / 10.0 + 0.05, (i / 10) as f64 / 10.0 + 0.05);
+            sum += x * x + y * y;
+        }
+        assert!((sum / 100.0 - 0.5).abs() < 0.01, "{}", sum / 100.0);
     }
 
     #[test]

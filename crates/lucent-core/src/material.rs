@@ -1,6 +1,7 @@
 //! Scene commands: `ambient`, `diffuse`, `specular`, `emission`, `shininess` — the
-//! material every object captures when it is created (SCENE_FORMAT.md §3.6). In the
-//! Whitted ray tracer `specular` is also the mirror reflectance.
+//! material every object captures when it is created (SCENE_FORMAT.md §3.6) — and the
+//! extensions `transparent`, `ior` and `glossy`. In the Whitted ray tracer `specular` is
+//! also the mirror reflectance.
 
 use crate::math::Color;
 
@@ -11,6 +12,21 @@ pub struct Material {
     pub specular: Color,
     pub emission: Color,
     pub shininess: f32,
+    /// `transparent`: the weight of the refracted ray (0: opaque).
+    pub transparent: Color,
+    /// `ior`: index of refraction of the inside.
+    pub ior: f32,
+    /// `glossy exponent samples`: the mirror ray becomes rays from a Phong lobe.
+    pub glossy: Option<Glossy>,
+    /// The geometry of a `quadLight`: shows its radiance (`emission`) from the emitting
+    /// side, black from behind, and reflects nothing.
+    pub is_light: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Glossy {
+    pub exponent: f32,
+    pub samples: u32,
 }
 
 impl Default for Material {
@@ -22,6 +38,10 @@ impl Default for Material {
             specular: Color::ZERO,
             emission: Color::ZERO,
             shininess: 1.0,
+            transparent: Color::ZERO,
+            ior: 1.0,
+            glossy: None,
+            is_light: false,
         }
     }
 }

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use crate::film::Film;
 use crate::integrator::Integrator;
 use crate::math::Color;
+use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
 
 pub const TILE_SIZE: u32 = 16;
@@ -86,15 +87,36 @@ pub fn render(scene: &Scene, integrator: &dyn Integrator, control: &RenderContro
 fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<Color>, RenderStats) {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut stats = RenderStats::default();
+    let n = scene.samples_per_pixel.max(1);
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
-            let ray = scene.camera.ray(x as f64 + 0.5, y as f64 + 0.5);
-            let mut c = integrator.radiance(scene, &ray, &mut stats.rays);
-            if !c.is_finite() {
-                stats.bad_samples += 1;
-                c = Color::ZERO;
+            let mut sum = Color::ZERO;
+            for i in 0..n {
+                let mut sampler = Sampler::new(x, y, i);
+                // One sample goes through the pixel centre; more are jittered over the
+                // pixel (one per cell of a √n × √n grid when n is a square).
+                let (dx, dy) = if n == 1 {
+                    (0.5, 0.5)
+                } else {
+                    let (u, v) = sampler.uniform2();
+                    stratified(i, n, u, v)
+                };
+                let lens = if scene.camera.has_lens() {
+                    let (u, v) = sampler.uniform2();
+                    stratified(i, n, u, v)
+                } else {
+                    (0.5, 0.5)
+                };
+                let ray = scene.camera.ray(x as f64 + dx as f64, y as f64 + dy as f64, lens);
+                let c = integrator.radiance(scene, &ray, &mut sampler, &mut stats.rays);
+                if c.is_finite() {
+                    sum += c;
+                } else {
+                    stats.bad_samples += 1;
+                }
             }
-            pixels.push(c);
+            // The box filter: every sample of the pixel counts the same.
+            pixels.push(if n == 1 { sum } else { sum / n as f32 });
         }
     }
     (pixels, stats)

@@ -18,6 +18,8 @@ pub struct Scene {
     pub geometry: Geometry,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
+    /// `spp`: camera samples per pixel, box-filtered.
+    pub samples_per_pixel: u32,
     accel_kind: AccelKind,
 }
 
@@ -30,6 +32,7 @@ pub struct SceneParts {
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     pub vertex_normals: Vec<[Vec3A; 3]>,
+    pub samples_per_pixel: u32,
 }
 
 impl Scene {
@@ -42,6 +45,7 @@ impl Scene {
             materials,
             lights,
             vertex_normals,
+            samples_per_pixel,
         } = parts;
         Scene {
             width,
@@ -51,6 +55,7 @@ impl Scene {
             accel_kind: accel,
             materials,
             lights,
+            samples_per_pixel,
         }
     }
 
@@ -96,6 +101,7 @@ mod tests {
             materials: vec![Material::default()],
             lights: Vec::new(),
             vertex_normals: Vec::new(),
+            samples_per_pixel: 1,
         };
         Scene::new(parts, accel)
     }

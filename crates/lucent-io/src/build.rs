@@ -9,13 +9,14 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3, Vec3};
 use lucent_core::aabb::Aabb;
 use lucent_core::accel::AccelKind;
-use lucent_core::camera::Camera;
+use lucent_core::camera::{Camera, Projection};
 use lucent_core::geometry::Geometry;
 use lucent_core::instance::Instance;
 use lucent_core::integrator::whitted::Whitted;
 use lucent_core::integrator::Integrator;
-use lucent_core::light::Light;
-use lucent_core::math::Vec3A;
+use lucent_core::light::{Light, QuadLight};
+use lucent_core::material::Material;
+use lucent_core::math::{Color, Vec3A};
 use lucent_core::mesh::{MeshShape, TriangleMesh};
 use lucent_core::primitive::{Analytic, AnalyticKind, Primitive, Shape, Sphere};
 use lucent_core::scene::{Scene, SceneParts};
@@ -54,7 +55,18 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
     };
     let (width, height) = size.value;
     let c = cam.value;
-    let camera = Camera::look_at(c.eye, c.center, c.up, c.fovy, width, height).ok()?;
+    let mut camera = Camera::new(c.eye, c.center, c.up, c.projection, width, height).ok()?;
+    if let Some(lens) = &desc.lens {
+        let (aperture, focus) = lens.value;
+        if matches!(c.projection, Projection::Orthographic { .. }) {
+            diags.error(
+                lens.loc,
+                "lens: depth of field needs the perspective camera (this scene uses orthocamera)",
+            );
+        } else {
+            camera = camera.with_lens(aperture, focus);
+        }
+    }
 
     let max_depth = match desc.max_depth() {
         -1 => {
@@ -86,6 +98,8 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         .collect();
     let (primitives, vertex_normals) = build_primitives(desc, None, &objects, &view, diags);
 
+    let mut materials: Vec<Material> = desc.materials.iter().map(|m| m.base).collect();
+    let mut primitives = primitives;
     let mut lights = Vec::new();
     for l in &desc.lights {
         let t = &desc.transforms[l.transform as usize];
@@ -103,11 +117,29 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
                 color: to_f32(color),
                 attenuation: to_f32(attenuation),
             }),
-            LightKind::Quad { .. } => {
-                diags.error(
-                    l.loc,
-                    "quadLight: area lights are not implemented yet in the raytracer integrator",
-                );
+            LightKind::Quad { a, ab, ac, color } => {
+                let (a, ab, ac) = (to_f32(t.point(a)), to_f32(t.vector(ab)), to_f32(t.vector(ac)));
+                let Some(q) = QuadLight::new(a, ab, ac, to_f32(color)) else {
+                    diags.error(l.loc, "quadLight: the transformed light has no area");
+                    continue;
+                };
+                lights.push(Light::Quad(q));
+                // The light is geometry too: seen from its emitting side it shows its
+                // radiance, and it casts shadows like anything else.
+                materials.push(Material {
+                    ambient: Color::ZERO,
+                    emission: q.radiance,
+                    is_light: true,
+                    ..Material::default()
+                });
+                let material = materials.len() as u32 - 1;
+                let (b, c, d) = (a + ab, a + ab + ac, a + ac);
+                for p in [[a, b, c], [a, c, d]] {
+                    primitives.push(Primitive {
+                        shape: Shape::Triangle { p, normals: None },
+                        material,
+                    });
+                }
             }
         }
     }
@@ -115,7 +147,6 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
     if diags.has_errors() {
         return None;
     }
-    let materials = desc.materials.iter().map(|m| m.base).collect();
     let parts = SceneParts {
         width,
         height,
@@ -124,10 +155,15 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         materials,
         lights,
         vertex_normals,
+        samples_per_pixel: desc.spp.as_ref().map_or(1, |s| s.value),
     };
     Some(Built {
         scene: Scene::new(parts, options.accel),
-        integrator: Box::new(Whitted { max_depth }),
+        integrator: Box::new(Whitted {
+            max_depth,
+            light_samples: desc.light_samples.as_ref().map_or(1, |s| s.value),
+            light_stratify: desc.light_stratify.as_ref().is_some_and(|s| s.value),
+        }),
         gamma: desc.gamma() as f32,
     })
 }
@@ -254,14 +290,6 @@ fn check_settings(desc: &SceneDesc, diags: &mut Diagnostics) {
             return;
         }
     }
-    if let Some(s) = &desc.spp {
-        if s.value > 1 {
-            diags.error(
-                s.loc,
-                "spp: antialiasing (more than 1 sample per pixel) is not implemented yet",
-            );
-        }
-    }
     let only_for = |name: &str, loc, diags: &mut Diagnostics| {
         diags.warning(loc, format!("{name}: has no effect with integrator raytracer"));
     };
@@ -340,7 +368,11 @@ fn nurbs_mesh(surface: &lucent_core::shape::nurbs::NurbsSurface, t: &Transform, 
     let nearest = (camera.eye.clamp(lo, hi) - camera.eye)
         .length()
         .max(1e-3 * (hi - lo).length());
-    let pixel = 2.0 * nearest * (camera.fovy.to_radians() / 2.0).tan() / view.height as f64;
+    let view_height = match camera.projection {
+        Projection::Perspective { fovy } => 2.0 * nearest * (fovy.to_radians() / 2.0).tan(),
+        Projection::Orthographic { height } => height,
+    };
+    let pixel = view_height / view.height as f64;
     // Object-space tolerance: divide by the largest stretch of the transform.
     let m = t.m.matrix3;
     let stretch = m

@@ -20,7 +20,8 @@ pub struct CameraDesc {
     pub eye: DVec3,
     pub center: DVec3,
     pub up: DVec3,
-    pub fovy: f64,
+    /// `camera` (field of view) or `orthocamera` (view height).
+    pub projection: lucent_core::camera::Projection,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -179,6 +180,8 @@ pub struct SceneDesc {
     pub russian_roulette: Option<Located<bool>>,
     pub importance_sampling: Option<Located<DirectionSampling>>,
     pub gamma: Option<Located<f64>>,
+    /// `lens aperture focusdistance`.
+    pub lens: Option<Located<(f64, f64)>>,
 
     /// The `vertex` pile, untransformed.
     pub vertices: Vec<DVec3>,

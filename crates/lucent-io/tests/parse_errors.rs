@@ -274,21 +274,71 @@ fn unknown_commands_warn_or_fail_in_strict_mode() {
 #[test]
 fn unsupported_features_are_errors_not_silent_differences() {
     assert_eq!(
-        first_error("glossy 20 4"),
-        "t.test:3:1: error: glossy: this lucent extension (docs/scene-format.md) is not implemented yet"
+        first_error("envmap sky.hdr"),
+        "t.test:3:1: error: envmap: this lucent extension (docs/scene-format.md) is not implemented yet"
     );
     assert_eq!(
         first_error("integrator pathtracer"),
         "t.test:3:12: error: integrator: 'pathtracer' is not implemented yet (this version renders 'raytracer')"
     );
+}
+
+#[test]
+fn sampling_and_camera_extensions() {
+    assert_eq!(first_error("ior 0"), "t.test:3:5: error: ior: must be positive, got 0");
     assert_eq!(
-        first_error("quadLight 0 0 0 1 0 0 0 1 0 1 1 1"),
-        "t.test:3:1: error: quadLight: area lights are not implemented yet in the raytracer integrator"
+        first_error("ior -1.5"),
+        "t.test:3:5: error: ior: must be positive, got -1.5"
     );
     assert_eq!(
-        first_error("spp 4"),
-        "t.test:3:5: error: spp: antialiasing (more than 1 sample per pixel) is not implemented yet"
+        first_error("glossy 10 0"),
+        "t.test:3:11: error: glossy: samples must be between 1 and 4096, got 0"
     );
+    assert_eq!(
+        first_error("glossy -1 4"),
+        "t.test:3:8: error: glossy: the exponent must not be negative, got -1"
+    );
+    assert_eq!(
+        first_error("glossy 10"),
+        "t.test:3:10: error: glossy: expected an exponent and a number of samples, or 'off', got 1 argument"
+    );
+    assert_eq!(
+        first_error("lens -0.1 5"),
+        "t.test:3:6: error: lens: the aperture must not be negative, got -0.1"
+    );
+    assert_eq!(
+        first_error("lens 0.1 0"),
+        "t.test:3:10: error: lens: the focus distance must be positive, got 0"
+    );
+    assert_eq!(
+        first_error("orthocamera 0 0 5 0 0 0 0 1 0 0"),
+        "t.test:3:31: error: orthocamera: the view height must be positive, got 0"
+    );
+    assert_eq!(
+        first_error("spp -4"),
+        "t.test:3:5: error: spp: must be at least 1, got -4"
+    );
+    assert_eq!(
+        first_error("lightsamples 0"),
+        "t.test:3:14: error: lightsamples: must be at least 1, got 0"
+    );
+    let ortho_lens = "size 8 8\northocamera 0 0 5 0 0 0 0 1 0 3\nlens 0.1 4\n";
+    assert_eq!(
+        messages(ortho_lens, false),
+        ["t.test:3:1: error: lens: depth of field needs the perspective camera (this scene uses orthocamera)"]
+    );
+    for ok in [
+        "glossy off",
+        "glossy 50 16",
+        "transparent 1 1 1",
+        "ior 1.5",
+        "spp 16",
+        "lens 0.2 5",
+        "lightsamples 9",
+    ] {
+        let all = messages(&format!("{HEADER}{ok}\n"), true);
+        assert!(all.is_empty(), "{ok}: {all:?}");
+    }
 }
 
 #[test]

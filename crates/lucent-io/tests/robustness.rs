@@ -106,7 +106,7 @@ fn random_mutations_never_panic() {
                 let scene = built.scene;
                 for k in 0..16 {
                     let (x, y) = ((k % 4) as f64 * 4.0 + 0.5, (k / 4) as f64 * 3.0 + 0.5);
-                    let ray = scene.camera.ray(x, y);
+                    let ray = scene.camera.ray(x, y, (0.5, 0.5));
                     if let Some(hit) = scene.closest_hit(&ray) {
                         let _ = scene.surface_point(&hit, &ray);
                     }

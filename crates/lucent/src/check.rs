@@ -52,11 +52,14 @@ pub fn run(args: &CheckArgs) -> u8 {
             .map_or("raytrace.png (default)", |o| o.value.as_str())
     );
     println!(
-        "camera:     eye {} look-at {} up {} fovy {}",
+        "camera:     eye {} look-at {} up {} {}",
         v(c.eye),
         v(c.center),
         v(c.up),
-        c.fovy
+        match c.projection {
+            lucent_core::camera::Projection::Perspective { fovy } => format!("fovy {fovy}"),
+            lucent_core::camera::Projection::Orthographic { height } => format!("orthographic, height {height}"),
+        }
     );
     println!(
         "integrator: {}, maxdepth {}",

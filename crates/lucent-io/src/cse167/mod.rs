@@ -9,11 +9,12 @@
 
 mod meshes;
 mod objects;
+mod sampling;
 
 use std::path::Path;
 
 use glam::DVec3;
-use lucent_core::camera::{Camera, CameraError};
+use lucent_core::camera::{Camera, CameraError, Projection};
 use lucent_core::transform::Transform;
 
 use crate::desc::*;
@@ -53,6 +54,11 @@ const COMMANDS: &[&str] = &[
     "objectbegin",
     "objectend",
     "instance",
+    "transparent",
+    "ior",
+    "glossy",
+    "orthocamera",
+    "lens",
     "maxverts",
     "maxvertnorms",
     "vertex",
@@ -88,17 +94,12 @@ const COMMANDS: &[&str] = &[
 /// Commands of lucent's extensions (`../shared/EXTENSIONS.md`) that this version does not
 /// implement yet. Using one is an error, never a silently different picture.
 const NOT_YET_IMPLEMENTED: &[&str] = &[
-    "transparent",
-    "ior",
     "texture",
     "checker",
     "diffusemap",
     "bumpmap",
     "displacementmap",
-    "glossy",
     "envmap",
-    "orthocamera",
-    "lens",
 ];
 
 /// Reads and parses a scene file. A file that cannot be read is an error at `path:1:1`.
@@ -373,7 +374,25 @@ impl Parser {
                     self.set_global(c, |d| &mut d.output, v);
                 }
             }
-            "camera" => self.camera(c),
+            "camera" | "orthocamera" => self.camera(c),
+            "lens" => self.lens(c),
+            "transparent" => {
+                if let Some(v) = self.nums::<3>(c) {
+                    self.material.base.transparent = self.color_at(c, 0, &v).as_vec3a();
+                    self.material_id = None;
+                }
+            }
+            "ior" => {
+                if let Some([n]) = self.nums::<1>(c) {
+                    if n > 0.0 {
+                        self.material.base.ior = n as f32;
+                        self.material_id = None;
+                    } else {
+                        self.err_arg(c, 0, format!("ior: must be positive, got {}", c.args[0].text));
+                    }
+                }
+            }
+            "glossy" => self.glossy(c),
             "sphere" => self.sphere(c),
             "plane" | "box" | "cylinder" | "disk" | "cone" | "quadric" => self.analytic(c),
             "bezierpatches" => self.bezier_patches(c),
@@ -672,15 +691,22 @@ impl Parser {
         self.set_global(c, |d| &mut d.size, v);
     }
 
+    /// `camera … fovy` and `orthocamera … height`: either is the scene's camera (the
+    /// last one given wins).
     fn camera(&mut self, c: &Command) {
         let Some(v) = self.nums::<10>(c) else { return };
+        let projection = if c.name.text == "orthocamera" {
+            Projection::Orthographic { height: v[9] }
+        } else {
+            Projection::Perspective { fovy: v[9] }
+        };
         let cam = CameraDesc {
             eye: DVec3::new(v[0], v[1], v[2]),
             center: DVec3::new(v[3], v[4], v[5]),
             up: DVec3::new(v[6], v[7], v[8]),
-            fovy: v[9],
+            projection,
         };
-        match Camera::look_at(cam.eye, cam.center, cam.up, cam.fovy, 1, 1) {
+        match Camera::new(cam.eye, cam.center, cam.up, cam.projection, 1, 1) {
             Ok(_) => {
                 let v = Located {
                     value: cam,
@@ -696,11 +722,18 @@ impl Parser {
                     c.args[9].text
                 ),
             ),
+            Err(CameraError::HeightNotPositive) => self.err_arg(
+                c,
+                9,
+                format!("orthocamera: the view height must be positive, got {}", c.args[9].text),
+            ),
             Err(CameraError::EyeAtTarget) => {
-                self.err_span(c, 0, 6, "camera: the eye and the look-at point are the same")
+                let msg = format!("{}: the eye and the look-at point are the same", c.name.text);
+                self.err_span(c, 0, 6, msg)
             }
             Err(CameraError::UpParallelToView) => {
-                self.err_span(c, 6, 3, "camera: the up vector is parallel to the viewing direction")
+                let msg = format!("{}: the up vector is parallel to the viewing direction", c.name.text);
+                self.err_span(c, 6, 3, msg)
             }
         }
     }
