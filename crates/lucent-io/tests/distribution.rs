@@ -1,0 +1,131 @@
+//! The distribution effects of the `raytracer` integrator, rendered: antialiasing,
+//! soft shadows, refraction, glossy reflection, the orthographic camera — each checked
+//! against what can be worked out by hand, and all of them the same bytes for any
+//! thread count.
+
+use std::sync::atomic::AtomicBool;
+
+use lucent_core::accel::AccelKind;
+use lucent_core::render::{render, RenderControl};
+use lucent_io::build::{build, BuildOptions};
+use lucent_io::cse167::{parse_bytes, ParseOptions};
+
+fn render_bytes(text: &str, threads: usize) -> Vec<u8> {
+    let (desc, mut diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions::default());
+    let built = build(&desc, &BuildOptions { accel: AccelKind::Bvh }, &mut diags)
+        .unwrap_or_else(|| panic!("{}", diags.render(&desc.sources)));
+    assert!(!diags.has_errors(), "{}", diags.render(&desc.sources));
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    let cancel = AtomicBool::new(false);
+    let control = RenderControl {
+        progress: &|_| {},
+        cancel: &cancel,
+    };
+    let (film, _) = pool
+        .install(|| render(&built.scene, built.integrator.as_ref(), &control))
+        .unwrap();
+    film.to_rgb8(built.gamma)
+}
+
+/// An emissive rectangle `x0..x1 × y0..y1` in the plane z = 0, seen from +z.
+fn emitter(x0: f64, x1: f64, y0: f64, y1: f64, first_vertex: usize) -> String {
+    let v = first_vertex;
+    format!(
+        "ambient 0 0 0\nemission 1 1 1\nvertex {x0} {y0} 0\nvertex {x1} {y0} 0\nvertex {x1} {y1} 0\nvertex {x0} {y1} 0\n\
+         tri {} {} {}\ntri {} {} {}\nemission 0 0 0\n",
+        v,
+        v + 1,
+        v + 2,
+        v,
+        v + 2,
+        v + 3
+    )
+}
+
+#[test]
+fn antialiasing_averages_stratified_samples_over_the_pixel() {
+    // One pixel covering [-1, 1]² through an orthographic camera; the left half of it is
+    // an emitter of value 1. A 4 × 4 stratified grid puts exactly 8 samples on it: 0.5,
+    // which the 8-bit truncation makes 127.
+    let scene = |spp: u32| {
+        format!(
+            "size 1 1\northocamera 0 0 5 0 0 0 0 1 0 2\nspp {spp}\n{}",
+            emitter(-10.0, 0.0, -10.0, 10.0, 0)
+        )
+    };
+    assert_eq!(render_bytes(&scene(16), 1), [127, 127, 127]);
+    // Nine samples (3 × 3): the middle column straddles the edge, so between 3/9 and 6/9.
+    let nine = render_bytes(&scene(9), 1)[0];
+    assert!((85..=170).contains(&nine), "{nine}");
+}
+
+#[test]
+fn the_orthographic_camera_sees_a_sphere_at_its_true_size() {
+    // Height 4 over 40 pixels: a unit sphere covers a disc of radius 10 pixels.
+    let text = "size 40 40\northocamera 0 0 5 0 0 0 0 1 0 4\nambient 0 0 0\nemission 1 1 1\nsphere 0 0 0 1\n";
+    let img = render_bytes(text, 1);
+    let lit = img.chunks(3).filter(|p| p[0] == 255).count();
+    let disc = std::f64::consts::PI * 100.0;
+    assert!((lit as f64 - disc).abs() < 20.0, "{lit} pixels vs {disc}");
+}
+
+#[test]
+fn area_lights_cast_soft_shadows_and_point_lights_hard_ones() {
+    // A floor lit from above, a small box hovering over it; a row of pixels across the
+    // shadow's edge. The point light gives lit and shadowed pixels only; the quad light
+    // gives a penumbra of values in between, rising steadily from the umbra outward.
+    // The camera looks down from just above the floor, under the box, so it sees only
+    // the floor.
+    let common = "size 64 8\northocamera 0 0.3 0 0 0 0 0 0 -1 2\nambient 0 0 0\ndiffuse 1 1 1\n\
+                  vertex -20 0 -20\nvertex 20 0 -20\nvertex 20 0 20\nvertex -20 0 20\ntri 0 2 1\ntri 0 3 2\n\
+                  box -8 1 -8 0 1.1 8\n";
+    let hard = render_bytes(&format!("{common}point 0 2 0 1 1 1\n"), 1);
+    let soft = render_bytes(
+        &format!("{common}lightsamples 64\nlightstratify on\nquadLight -3 2 -3 0 0 6 6 0 0 2 2 2\n"),
+        1,
+    );
+    let row = |img: &[u8]| -> Vec<u8> { (0..64).map(|x| img[3 * (4 * 64 + x)]).collect() };
+    let (hard, soft) = (row(&hard), row(&soft));
+    // Hard: black, then at once (nearly) full light.
+    let edge = hard.iter().position(|&v| v > 0).unwrap();
+    assert!(edge > 0 && hard[edge] > 200, "{hard:?}");
+    // Soft: from black up to the brightest pixel through a penumbra, never darkening.
+    let peak = soft.iter().enumerate().max_by_key(|(_, &v)| v).unwrap().0;
+    let rise = &soft[..=peak];
+    assert!(rise.windows(2).all(|w| w[1] >= w[0]), "{soft:?}");
+    let penumbra = rise
+        .iter()
+        .filter(|&&v| v > 0 && (v as u32) < 9 * soft[peak] as u32 / 10)
+        .count();
+    assert!(penumbra >= 6 && soft[0] == 0, "{soft:?}");
+}
+
+#[test]
+fn glass_of_index_one_is_invisible_and_glass_of_index_one_and_a_half_is_not() {
+    // Behind the sphere an emitter with a sharp edge; no lights, so shading is only what
+    // the rays see. With ior 1 and no reflection the sphere bends nothing.
+    let backdrop = emitter(-10.0, 0.3, -10.0, 10.0, 0);
+    let base = format!("size 40 30\ncamera 0 0 6 0 0 0 0 1 0 40\nmaxdepth 4\n{backdrop}");
+    let empty = render_bytes(&base, 1);
+    let glass = |ior: f64| {
+        format!("{base}pushTransform\ntranslate 0 0 2\nambient 0 0 0\nspecular 0 0 0\ntransparent 1 1 1\nior {ior}\nsphere 0 0 0 1\npopTransform\n")
+    };
+    let same = render_bytes(&glass(1.0), 1);
+    let differing = empty.chunks(3).zip(same.chunks(3)).filter(|(a, b)| a != b).count();
+    assert!(differing <= 2, "{differing} pixels differ");
+    let bent = render_bytes(&glass(1.5), 1);
+    let differing = empty.chunks(3).zip(bent.chunks(3)).filter(|(a, b)| a != b).count();
+    assert!(differing > 40, "{differing}");
+}
+
+#[test]
+fn every_effect_gives_the_same_bytes_for_any_thread_count() {
+    let text = "size 48 36\ncamera 0 2 6 0 0.5 0 0 1 0 45\nspp 4\nlightsamples 4\nlightstratify on\nlens 0.1 6\n\
+                quadLight -1 4 -1 0 0 2 2 0 0 5 5 5\nambient 0.05 0.05 0.05\ndiffuse 0.6 0.6 0.6\n\
+                plane 0 0 0 0 1 0\nspecular 0.7 0.7 0.7\nglossy 30 4\nsphere -1 1 0 1\nglossy off\n\
+                transparent 0.9 0.9 0.9\nior 1.5\nspecular 1 1 1\ndiffuse 0 0 0\nsphere 1.2 0.7 0.5 0.7\n";
+    let one = render_bytes(text, 1);
+    assert_eq!(one, render_bytes(text, 2));
+    assert_eq!(one, render_bytes(text, 3));
+    assert!(one.iter().any(|&v| v > 50));
+}
