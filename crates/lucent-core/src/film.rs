@@ -21,6 +21,12 @@ impl Film {
         }
     }
 
+    /// Interleaved linear RGB floats, top row first (for EXR and HDR files); samples
+    /// that were not finite are already 0.
+    pub fn to_rgb_f32(&self) -> Vec<f32> {
+        self.pixels.iter().flat_map(|p| p.to_array()).collect()
+    }
+
     /// Interleaved 8-bit RGB, top row first.
     pub fn to_rgb8(&self, gamma: f32) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.pixels.len() * 3);

@@ -59,6 +59,30 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(),
     write_file_atomically(path, &png)
 }
 
+/// Writes linear RGB floats (interleaved, top row first) as an OpenEXR file (32-bit
+/// float channels), atomically: the render's values before clamping and encoding.
+pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[f32]) -> Result<(), ImageError> {
+    let mut out = std::io::Cursor::new(Vec::new());
+    let bytes: Vec<u8> = rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
+    image::codecs::openexr::OpenExrEncoder::new(&mut out)
+        .write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F)
+        .map_err(|e| write_error(path, e))?;
+    write_file_atomically(path, &out.into_inner())
+}
+
+/// Writes linear RGB floats as a Radiance RGBE (`.hdr`) file, atomically.
+pub fn write_hdr(path: &Path, width: u32, height: u32, rgb: &[f32]) -> Result<(), ImageError> {
+    let mut out = Vec::new();
+    let pixels: Vec<image::Rgb<f32>> = rgb
+        .chunks_exact(3)
+        .map(|c| image::Rgb([c[0].max(0.0), c[1].max(0.0), c[2].max(0.0)]))
+        .collect();
+    image::codecs::hdr::HdrEncoder::new(&mut out)
+        .encode(&pixels, width as usize, height as usize)
+        .map_err(|e| write_error(path, e))?;
+    write_file_atomically(path, &out)
+}
+
 /// Writes `bytes` to a temporary file beside `path`, syncs it and renames it over
 /// `path`: readers see the old file or the whole new one, never a part.
 pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {

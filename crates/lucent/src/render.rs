@@ -9,7 +9,7 @@ use lucent_core::accel::AccelKind;
 use lucent_core::render::{render, RenderControl};
 use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_file, ParseOptions};
-use lucent_io::image::{check_writable, write_png};
+use lucent_io::image::check_writable;
 
 use crate::output::{choose_output, report};
 use crate::progress::Progress;
@@ -103,8 +103,7 @@ pub fn run(args: &RenderArgs) -> u8 {
             stats.bad_samples
         );
     }
-    let rgb = film.to_rgb8(built.gamma);
-    if let Err(e) = write_png(&out, film.width, film.height, &rgb) {
+    if let Err(e) = crate::output::write_image(&out, &film, built.gamma) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }

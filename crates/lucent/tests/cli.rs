@@ -359,3 +359,26 @@ fn bench_rays_rejects_bad_files_without_writing() {
         assert!(!dir.join("h.bin").exists());
     }
 }
+
+#[test]
+fn exr_and_hdr_keep_the_linear_values_png_encodes() {
+    // An emitter of 2.5 (beyond what 8 bits can hold) and one of 0.25.
+    let dir = workdir("exr");
+    let scene = "size 20 10\northocamera 0 0 5 0 0 0 0 1 0 2\nambient 0 0 0\nemission 2.5 0.25 1\n\
+                 vertex -10 -10 0\nvertex 0 -10 0\nvertex 0 10 0\nvertex -10 10 0\ntri 0 1 2\ntri 0 2 3\n";
+    fs::write(dir.join("e.test"), scene).unwrap();
+    for name in ["out.exr", "out.hdr", "out.png"] {
+        let o = lucent(&dir, &["render", "e.test", "-o", name, "-q"]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+    }
+    let exr = image::open(dir.join("out.exr")).unwrap().to_rgb32f();
+    assert_eq!(exr.dimensions(), (20, 10));
+    assert_eq!(exr.get_pixel(2, 5).0, [2.5, 0.25, 1.0], "linear values, exactly");
+    assert_eq!(exr.get_pixel(17, 5).0, [0.0, 0.0, 0.0]);
+    let hdr = image::open(dir.join("out.hdr")).unwrap().to_rgb32f();
+    let p = hdr.get_pixel(2, 5).0;
+    assert!((p[0] - 2.5).abs() < 0.02 && (p[1] - 0.25).abs() < 0.01, "{p:?}");
+    let png = image::open(dir.join("out.png")).unwrap().to_rgb8();
+    assert_eq!(png.get_pixel(2, 5).0, [255, 63, 255]);
+    assert_eq!(files_in(&dir), ["e.test", "out.exr", "out.hdr", "out.png"]);
+}
