@@ -62,6 +62,11 @@ impl Geometry {
         self.accel.occluded(&self.primitives, ray)
     }
 
+    /// World-space `∂p/∂u`, `∂p/∂v` at `hit` (see [`Primitive::tangents`]).
+    pub fn tangents(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> (Vec3A, Vec3A) {
+        self.primitives[hit.prim as usize].tangents(hit, origin, dir)
+    }
+
     /// Shading data at `hit` on the ray `origin + t·dir`.
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> SurfacePoint {
         self.primitives[hit.prim as usize].surface_point(hit, origin, dir, &self.vertex_normals)

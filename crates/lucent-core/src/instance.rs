@@ -64,6 +64,15 @@ impl Instance {
         self.object.occluded(&self.to_object(&ray.ray, t_max))
     }
 
+    /// World-space `∂p/∂u`, `∂p/∂v` at `hit`.
+    pub fn tangents(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> (Vec3A, Vec3A) {
+        let o = self.world_to_object.transform_point3a(origin);
+        let d = self.world_to_object.transform_vector3a(dir);
+        let (du, dv) = self.object.tangents(hit, o, d);
+        let m = self.object_to_world.matrix3;
+        (m * du, m * dv)
+    }
+
     /// Shading data in world space at `hit` (as [`Instance::intersect`] gave it).
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> SurfacePoint {
         let o = self.world_to_object.transform_point3a(origin);

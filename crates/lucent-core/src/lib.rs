@@ -27,4 +27,5 @@ pub mod render;
 pub mod sampler;
 pub mod scene;
 pub mod shape;
+pub mod texture;
 pub mod transform;

@@ -18,9 +18,19 @@ pub struct Material {
     pub ior: f32,
     /// `glossy exponent samples`: the mirror ray becomes rays from a Phong lobe.
     pub glossy: Option<Glossy>,
+    /// `diffusemap`: index of the texture that multiplies `diffuse`.
+    pub diffuse_map: Option<u32>,
+    /// `bumpmap`: the texture whose luminance, times `strength`, is a height field.
+    pub bump_map: Option<BumpMap>,
     /// The geometry of a `quadLight`: shows its radiance (`emission`) from the emitting
     /// side, black from behind, and reflects nothing.
     pub is_light: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BumpMap {
+    pub texture: u32,
+    pub strength: f32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,6 +51,8 @@ impl Default for Material {
             transparent: Color::ZERO,
             ior: 1.0,
             glossy: None,
+            diffuse_map: None,
+            bump_map: None,
             is_light: false,
         }
     }

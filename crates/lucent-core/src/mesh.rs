@@ -130,6 +130,17 @@ impl TriangleMesh {
             + self.materials.len() * size_of::<u32>()
     }
 
+    /// `∂p/∂u`, `∂p/∂v` of triangle `hit.prim` (from its texture coordinates, or its
+    /// barycentric ones when the mesh has none).
+    pub fn tangents(&self, hit: &Hit) -> (Vec3A, Vec3A) {
+        let p = self.corners(hit.prim);
+        if self.uvs.is_empty() {
+            return (p[1] - p[0], p[2] - p[0]);
+        }
+        let uv = self.indices[hit.prim as usize].map(|i| self.uvs[i as usize]);
+        crate::shape::parametric::triangle_tangents(p, uv)
+    }
+
     /// Shading data at `hit` (whose `prim` is the triangle) on the ray `origin + t·dir`.
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> SurfacePoint {
         let k = hit.prim as usize;

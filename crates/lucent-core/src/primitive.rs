@@ -239,6 +239,32 @@ impl Primitive {
         }
     }
 
+    /// World-space `∂p/∂u` and `∂p/∂v` at a hit of `origin + t·dir` (for bump mapping):
+    /// exact for triangles, by differences of the texture-coordinate formulas for the
+    /// other shapes.
+    pub fn tangents(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> (Vec3A, Vec3A) {
+        use crate::shape::parametric::uv_tangents;
+        let object_point = |w2o: &Affine3A| w2o.transform_point3a(origin) + w2o.transform_vector3a(dir) * hit.t;
+        match &self.shape {
+            Shape::Triangle { p, .. } => (p[1] - p[0], p[2] - p[0]),
+            Shape::Sphere(s) => {
+                let p = object_point(&s.world_to_object).normalize();
+                let (du, dv) = uv_tangents(p, p, |q| texcoord::sphere(q.normalize()));
+                let m = s.world_to_object.matrix3.inverse();
+                (m * du, m * dv)
+            }
+            Shape::Analytic(a) => {
+                let p = object_point(&a.world_to_object);
+                let n = a.kind.normal(p).normalize();
+                let (du, dv) = uv_tangents(p, n, |q| a.kind.uv(q, n));
+                let m = a.world_to_object.matrix3.inverse();
+                (m * du, m * dv)
+            }
+            Shape::Mesh(m) => m.mesh.tangents(&hit.inside()),
+            Shape::Instance(i) => i.tangents(&hit.inside(), origin, dir),
+        }
+    }
+
     /// Shading data at a hit of `origin + t·dir` on this primitive.
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A, vertex_normals: &[[Vec3A; 3]]) -> SurfacePoint {
         match &self.shape {

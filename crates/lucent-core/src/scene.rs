@@ -10,6 +10,7 @@ use crate::material::Material;
 use crate::math::Vec3A;
 use crate::primitive::Primitive;
 use crate::ray::Ray;
+use crate::texture::{EnvironmentMap, Texture};
 
 pub struct Scene {
     pub width: u32,
@@ -20,6 +21,10 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// `spp`: camera samples per pixel, box-filtered.
     pub samples_per_pixel: u32,
+    /// `texture` and `checker`, indexed by the materials' maps.
+    pub textures: Vec<Texture>,
+    /// `envmap`: what rays that hit nothing see (black without one).
+    pub environment: Option<EnvironmentMap>,
     accel_kind: AccelKind,
 }
 
@@ -33,6 +38,8 @@ pub struct SceneParts {
     pub lights: Vec<Light>,
     pub vertex_normals: Vec<[Vec3A; 3]>,
     pub samples_per_pixel: u32,
+    pub textures: Vec<Texture>,
+    pub environment: Option<EnvironmentMap>,
 }
 
 impl Scene {
@@ -46,6 +53,8 @@ impl Scene {
             lights,
             vertex_normals,
             samples_per_pixel,
+            textures,
+            environment,
         } = parts;
         Scene {
             width,
@@ -56,6 +65,8 @@ impl Scene {
             materials,
             lights,
             samples_per_pixel,
+            textures,
+            environment,
         }
     }
 
@@ -71,6 +82,11 @@ impl Scene {
 
     pub fn surface_point(&self, hit: &Hit, ray: &Ray) -> SurfacePoint {
         self.geometry.surface_point(hit, ray.origin, ray.dir)
+    }
+
+    /// `∂p/∂u`, `∂p/∂v` at the hit (bump mapping asks for them).
+    pub fn tangents(&self, hit: &Hit, ray: &Ray) -> (Vec3A, Vec3A) {
+        self.geometry.tangents(hit, ray.origin, ray.dir)
     }
 
     pub fn accel_kind(&self) -> AccelKind {
@@ -102,6 +118,8 @@ mod tests {
             lights: Vec::new(),
             vertex_normals: Vec::new(),
             samples_per_pixel: 1,
+            textures: Vec::new(),
+            environment: None,
         };
         Scene::new(parts, accel)
     }

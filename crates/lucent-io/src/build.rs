@@ -156,6 +156,8 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
         lights,
         vertex_normals,
         samples_per_pixel: desc.spp.as_ref().map_or(1, |s| s.value),
+        textures: desc.textures.iter().map(|t| t.texture.clone()).collect(),
+        environment: desc.environment.as_ref().map(|e| e.value.clone()),
     };
     Some(Built {
         scene: Scene::new(parts, options.accel),

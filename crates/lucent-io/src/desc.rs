@@ -115,6 +115,14 @@ pub struct ShapeDesc {
     pub loc: Loc,
 }
 
+/// A named texture.
+#[derive(Clone, Debug)]
+pub struct TextureDesc {
+    pub name: String,
+    pub texture: lucent_core::texture::Texture,
+    pub loc: Loc,
+}
+
 /// A named object: the shapes whose `object` is its index.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ObjectDesc {
@@ -192,6 +200,10 @@ pub struct SceneDesc {
     /// takes the material its shape captured.
     pub meshes: Vec<lucent_core::mesh::TriangleMesh>,
     pub objects: Vec<ObjectDesc>,
+    /// `texture` and `checker`, in the order defined; materials refer to them by index.
+    pub textures: Vec<TextureDesc>,
+    /// `envmap file [intensity]`.
+    pub environment: Option<Located<lucent_core::texture::EnvironmentMap>>,
     /// NURBS surfaces (`nurbs` with its `knotsu`, `knotsv` and `cpoint` lines), in object
     /// space; tessellated when the scene is built, when the camera says how fine.
     pub nurbs: Vec<lucent_core::shape::nurbs::NurbsSurface>,

@@ -18,3 +18,4 @@ mod number;
 pub mod obj;
 pub mod patches;
 pub mod ply;
+pub mod texture_file;

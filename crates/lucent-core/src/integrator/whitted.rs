@@ -26,13 +26,16 @@
 //!   surface count as black.
 
 use super::Integrator;
-use crate::hit::{SurfacePoint, BACKGROUND};
+use crate::hit::{Hit, SurfacePoint, BACKGROUND};
 use crate::light::Light;
+use crate::material::BumpMap;
 use crate::math::Color;
+use crate::math::Vec3A;
 use crate::optics::{fresnel_dielectric, phong_lobe, reflect, refract};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
+use crate::texture::{luminance, Texture};
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
 /// 8-bit step: they are not traced.
@@ -62,7 +65,7 @@ impl Whitted {
         let scene = t.scene;
         *t.rays += 1;
         let hit = scene.closest_hit(ray)?;
-        let sp = scene.surface_point(&hit, ray);
+        let mut sp = scene.surface_point(&hit, ray);
         let m = &scene.materials[sp.material as usize];
         if m.is_light {
             let seen = if ray.dir.dot(sp.normal) > 0.0 {
@@ -72,6 +75,13 @@ impl Whitted {
             };
             return Some((seen, sp));
         }
+        if let Some(bump) = m.bump_map {
+            sp.normal = bumped_normal(scene, &hit, ray, &sp, bump);
+        }
+        let diffuse = match m.diffuse_map {
+            Some(t) => m.diffuse * scene.textures[t as usize].eval(sp.uv, sp.point),
+            None => m.diffuse,
+        };
         let n = sp.normal;
         let view = -ray.dir;
         let mut color = m.ambient + m.emission;
@@ -87,7 +97,7 @@ impl Whitted {
                         (u, v)
                     };
                     let inc = q.incidence(sp.point, q.point(u, v));
-                    let reflected = m.diffuse * n.dot(inc.dir).max(0.0)
+                    let reflected = diffuse * n.dot(inc.dir).max(0.0)
                         + m.specular * n.dot((inc.dir + view).normalize()).max(0.0).powf(m.shininess);
                     if reflected == Color::ZERO || inc.intensity == Color::ZERO {
                         continue;
@@ -105,7 +115,7 @@ impl Whitted {
             let inc = light.incidence(sp.point);
             let n_dot_l = n.dot(inc.dir).max(0.0);
             let n_dot_h = n.dot((inc.dir + view).normalize()).max(0.0);
-            let reflected = m.diffuse * n_dot_l + m.specular * n_dot_h.powf(m.shininess);
+            let reflected = diffuse * n_dot_l + m.specular * n_dot_h.powf(m.shininess);
             // A light that could add nothing needs no shadow ray.
             if reflected == Color::ZERO || inc.intensity == Color::ZERO {
                 continue;
@@ -125,7 +135,13 @@ impl Whitted {
     fn trace(&self, t: &mut Tracing, ray: Ray, depth: u32, weight: Color, total: &mut Color) {
         let scene = t.scene;
         let (mut ray, mut depth, mut weight) = (ray, depth, weight);
-        while let Some((local, sp)) = self.shade(t, &ray) {
+        loop {
+            let Some((local, sp)) = self.shade(t, &ray) else {
+                if let Some(env) = &scene.environment {
+                    *total += weight * env.radiance(ray.dir);
+                }
+                break;
+            };
             *total += weight * local;
             let m = &scene.materials[sp.material as usize];
             if m.is_light || depth >= self.max_depth {
@@ -179,5 +195,33 @@ impl Integrator for Whitted {
         let mut t = Tracing { scene, sampler, rays };
         self.trace(&mut t, *ray, 0, Color::ONE, &mut total);
         total
+    }
+}
+
+/// The shading normal of a bump-mapped surface (Blinn 1978): the surface displaced along
+/// its normal by `strength × luminance` of the texture, differentiated along `∂p/∂u` and
+/// `∂p/∂v` by central differences half a texel wide.
+fn bumped_normal(scene: &Scene, hit: &Hit, ray: &Ray, sp: &SurfacePoint, bump: BumpMap) -> Vec3A {
+    let (dpdu, dpdv) = scene.tangents(hit, ray);
+    let tex = &scene.textures[bump.texture as usize];
+    let (du, dv) = match tex {
+        Texture::Image(img) => (0.5 / img.width as f32, 0.5 / img.height as f32),
+        Texture::Checker { .. } => (1e-3, 1e-3),
+    };
+    let height = |duv: glam::Vec2, dp: Vec3A| bump.strength * luminance(tex.eval(sp.uv + duv, sp.point + dp));
+    let u = glam::Vec2::new(du, 0.0);
+    let v = glam::Vec2::new(0.0, dv);
+    let hu = (height(u, dpdu * du) - height(-u, -dpdu * du)) / (2.0 * du);
+    let hv = (height(v, dpdv * dv) - height(-v, -dpdv * dv)) / (2.0 * dv);
+    let n = sp.normal;
+    let base = dpdu.cross(dpdv);
+    let bumped = (dpdu + n * hu).cross(dpdv + n * hv);
+    // The tangents' cross product may point to either side; the normal keeps its own.
+    let bumped = if base.dot(n) < 0.0 { -bumped } else { bumped };
+    let out = bumped.normalize();
+    if out.is_finite() {
+        out
+    } else {
+        n
     }
 }

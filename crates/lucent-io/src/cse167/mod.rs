@@ -10,6 +10,7 @@
 mod meshes;
 mod objects;
 mod sampling;
+mod textures;
 
 use std::path::Path;
 
@@ -59,6 +60,11 @@ const COMMANDS: &[&str] = &[
     "glossy",
     "orthocamera",
     "lens",
+    "texture",
+    "checker",
+    "diffusemap",
+    "bumpmap",
+    "envmap",
     "maxverts",
     "maxvertnorms",
     "vertex",
@@ -93,14 +99,7 @@ const COMMANDS: &[&str] = &[
 
 /// Commands of lucent's extensions (`../shared/EXTENSIONS.md`) that this version does not
 /// implement yet. Using one is an error, never a silently different picture.
-const NOT_YET_IMPLEMENTED: &[&str] = &[
-    "texture",
-    "checker",
-    "diffusemap",
-    "bumpmap",
-    "displacementmap",
-    "envmap",
-];
+const NOT_YET_IMPLEMENTED: &[&str] = &["displacementmap"];
 
 /// Reads and parses a scene file. A file that cannot be read is an error at `path:1:1`.
 pub fn parse_file(path: &Path, options: ParseOptions) -> (SceneDesc, Diagnostics) {
@@ -393,6 +392,10 @@ impl Parser {
                 }
             }
             "glossy" => self.glossy(c),
+            "texture" | "checker" => self.texture(c),
+            "diffusemap" => self.diffuse_map(c),
+            "bumpmap" => self.bump_map(c),
+            "envmap" => self.environment(c),
             "sphere" => self.sphere(c),
             "plane" | "box" | "cylinder" | "disk" | "cone" | "quadric" => self.analytic(c),
             "bezierpatches" => self.bezier_patches(c),
