@@ -7,6 +7,9 @@
   cube.obj               a cube of six quads, the control cage for Catmull-Clark
   tetra.obj              a tetrahedron, the control cage for Loop
   letter_l.obj           an L-shaped prism of quads (valence-3, -4 and -5 vertices)
+  bricks.png             a brick wall (diffuse map), 8-bit sRGB
+  bricks_height.png      its height field for bump mapping (mortar low, bricks high)
+  sky.png                an equirectangular sky: blue gradient, a horizon, a sun toward -z
 
 Run from the repository root: python3 scripts/make_models.py
 """
@@ -128,6 +131,73 @@ def letter_l(path):
     write_obj(path, "an L-shaped prism of quads: the control cage of a Catmull-Clark surface", verts, faces)
 
 
+def write_png(path, width, height, pixel):
+    """A minimal 8-bit RGB PNG writer (zlib, filter 0): no imaging library needed."""
+    import zlib
+
+    rows = b"".join(b"\x00" + bytes(c for x in range(width) for c in pixel(x, y)) for y in range(height))
+
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows, 9)) + chunk(b"IEND", b""))
+
+
+def brick(x, y, w=256, h=128):
+    """(is mortar, brick id) at texel (x, y): 8 rows of bricks, every other row offset."""
+    row = y * 8 // h
+    bx = (x + (w // 16 if row % 2 else 0)) % w
+    col = bx * 8 // w
+    in_x = bx % (w // 8)
+    in_y = y % (h // 8)
+    mortar = in_x < 2 or in_y < 2
+    return mortar, row * 8 + col
+
+
+def bricks(path):
+    def pixel(x, y):
+        mortar, k = brick(x, y)
+        if mortar:
+            return (200, 195, 185)
+        shade = 150 + (k * 37) % 60
+        return (shade, shade * 55 // 100, shade * 40 // 100)
+
+    write_png(path, 256, 128, pixel)
+
+
+def bricks_height(path):
+    def pixel(x, y):
+        mortar, _ = brick(x, y)
+        v = 40 if mortar else 220
+        return (v, v, v)
+
+    write_png(path, 256, 128, pixel)
+
+
+def sky(path, w=512, h=256):
+    def pixel(x, y):
+        # Longitude: u = 0.5 looks along -z; latitude: row 0 is straight up.
+        u, v = (x + 0.5) / w, (y + 0.5) / h
+        phi = (u - 0.5) * 2 * math.pi
+        theta = v * math.pi
+        d = (math.sin(theta) * math.sin(phi), math.cos(theta), -math.sin(theta) * math.cos(phi))
+        if d[1] < 0:
+            g = 60 + int(40 * (1 + d[1]))
+            return (g, g * 9 // 10, g * 7 // 10)
+        t = d[1]
+        r, g, b = int(110 + 60 * (1 - t)), int(150 + 60 * (1 - t)), 235
+        sun = (0.3, 0.35, -0.89)
+        c = sum(a * b for a, b in zip(d, sun)) / math.sqrt(sum(a * a for a in sun))
+        if c > 0.995:
+            return (255, 250, 230)
+        return (r, g, b)
+
+    write_png(path, w, h, pixel)
+
+
 if __name__ == "__main__":
     os.makedirs(OUT, exist_ok=True)
     torus(os.path.join(OUT, "torus.obj"), os.path.join(OUT, "torus.mtl"))
@@ -135,3 +205,6 @@ if __name__ == "__main__":
     cube(os.path.join(OUT, "cube.obj"))
     tetra(os.path.join(OUT, "tetra.obj"))
     letter_l(os.path.join(OUT, "letter_l.obj"))
+    bricks(os.path.join(OUT, "bricks.png"))
+    bricks_height(os.path.join(OUT, "bricks_height.png"))
+    sky(os.path.join(OUT, "sky.png"))

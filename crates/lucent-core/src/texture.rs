@@ -48,7 +48,8 @@ impl Image {
 pub enum Texture {
     Image(Image),
     /// Alternating cubes of side `scale` in world space: `a` where the cell indices sum
-    /// to an even number, `b` elsewhere.
+    /// to an even number, `b` elsewhere. Cell boundaries sit 10⁻⁴ of a cell below the
+    /// multiples of `scale`, so surfaces on those planes are in one cell.
     Checker {
         a: Color,
         b: Color,
@@ -62,7 +63,9 @@ impl Texture {
         match self {
             Texture::Image(img) => img.at_uv(uv),
             Texture::Checker { a, b, scale } => {
-                let c = (p / *scale).floor();
+                // Nudged by 10⁻⁴ of a cell: a floor lying exactly on a cell boundary
+                // (y = 0 is one) would otherwise flip between cells with rounding noise.
+                let c = (p / *scale + Vec3A::splat(1e-4)).floor();
                 let parity = (c.x as i64 + c.y as i64 + c.z as i64).rem_euclid(2);
                 if parity == 0 {
                     *a
@@ -156,6 +159,8 @@ mod tests {
         assert_eq!(at(2.5, 0.5, 0.5), 0.0);
         assert_eq!(at(2.5, 2.5, 0.5), 1.0);
         assert_eq!(at(-0.5, 0.5, 0.5), 0.0);
+        // A floor at y = 0 with rounding noise stays in one cell.
+        assert_eq!(at(0.5, -1e-7, 0.5), at(0.5, 1e-7, 0.5));
     }
 
     #[test]
