@@ -223,8 +223,19 @@ fn build_primitives(
                 }
                 Shape::Mesh(MeshShape::new(mesh, view.accel))
             }
-            ShapeKind::Nurbs { index } => {
+            ShapeKind::Nurbs { index, displacement } => {
                 let mut mesh = nurbs_mesh(&desc.nurbs[index as usize], t, view);
+                if let Some((texture, scale)) = displacement {
+                    let tex = &desc.textures[texture as usize].texture;
+                    match lucent_core::shape::displacement::displace(&mesh, tex, scale) {
+                        Ok(m) => mesh = m,
+                        Err(e) => {
+                            diags.error(s.loc, format!("nurbs: displacementmap: {e}"));
+                            continue;
+                        }
+                    }
+                    mesh.remove_degenerate();
+                }
                 mesh.material = s.material;
                 if mesh.indices.is_empty() {
                     continue;

@@ -92,8 +92,12 @@ pub enum ShapeKind {
     Mesh { index: u32 },
     /// `instance name`: index into [`SceneDesc::objects`].
     Instance { object: u32 },
-    /// A NURBS surface: index into [`SceneDesc::nurbs`].
-    Nurbs { index: u32 },
+    /// A NURBS surface: index into [`SceneDesc::nurbs`], and the `displacementmap`
+    /// (texture index and scale) current at its `nurbs` command.
+    Nurbs {
+        index: u32,
+        displacement: Option<(u32, f32)>,
+    },
     /// `quadric a … j x0 y0 z0 x1 y1 z1`: coefficients (not all zero) and the clip box.
     Quadric {
         coefficients: [f64; 10],

@@ -274,10 +274,6 @@ fn unknown_commands_warn_or_fail_in_strict_mode() {
 #[test]
 fn unsupported_features_are_errors_not_silent_differences() {
     assert_eq!(
-        first_error("displacementmap bumps 0.1"),
-        "t.test:3:1: error: displacementmap: this lucent extension (docs/scene-format.md) is not implemented yet"
-    );
-    assert_eq!(
         first_error("integrator pathtracer"),
         "t.test:3:12: error: integrator: 'pathtracer' is not implemented yet (this version renders 'raytracer')"
     );

@@ -211,3 +211,39 @@ fn texture_errors_point_at_the_command() {
         ["3:8: bumpmap: expected a texture name and a strength, or 'off', got 0 arguments"]
     );
 }
+
+#[test]
+fn a_displacement_map_moves_the_surface_before_it_is_rendered() {
+    // The unit square displaced by a uniform texture of luminance 1 and scale 0.5 moves
+    // to z = 0.5 along its normal (+z): a camera looking down from z = 5 sees it 0.5
+    // closer, which a distance-dependent point light shows.
+    let dir = TempDir::new("displace");
+    std::fs::write(dir.0.join("square.obj"), SQUARE_OBJ).unwrap();
+    image::RgbImage::from_raw(1, 1, vec![255, 255, 255])
+        .unwrap()
+        .save(dir.0.join("white.png"))
+        .unwrap();
+    let scene = |extra: &str| {
+        format!(
+            "size 2 2\northocamera 0.5 0.5 5 0.5 0.5 0 0 1 0 1\nambient 0 0 0\nattenuation 0 0 1\n\
+             point 0.5 0.5 2 1 1 1\ndiffuse 1 1 1\ntexture white white.png\n{extra}mesh square.obj\n"
+        )
+    };
+    let flat = render_film(&dir.scene(), &scene(""));
+    let raised = render_film(&dir.scene(), &scene("displacementmap white 0.5\n"));
+    // Pixel centres are (0.25, 0.25) … from the surface; the light is 2 (flat) or 1.5
+    // (raised) above the square: irradiance cos θ / r² with r² = 0.125 + h².
+    let expect = |h: f32| h / (0.125f32 + h * h).powf(1.5);
+    assert!((flat[0][0] - expect(2.0)).abs() < 1e-3, "{:?}", flat[0]);
+    assert!((raised[0][0] - expect(1.5)).abs() < 1e-3, "{:?}", raised[0]);
+    // Without texture coordinates an image cannot be looked up: an error at the mesh.
+    std::fs::write(dir.0.join("bare.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    let errs = errors(
+        &dir.scene(),
+        "size 2 2\ncamera 0 0 5 0 0 0 0 1 0 45\ntexture white white.png\ndisplacementmap white 1\nmesh bare.obj\n",
+    );
+    assert_eq!(
+        errs,
+        ["5:1: mesh: displacementmap: the surface has no texture coordinates to look the image up at"]
+    );
+}

@@ -7,6 +7,7 @@ pub mod cone;
 pub mod cuboid;
 pub mod cylinder;
 pub mod disk;
+pub mod displacement;
 pub mod nurbs;
 pub mod parametric;
 pub mod plane;

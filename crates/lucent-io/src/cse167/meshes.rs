@@ -205,9 +205,19 @@ impl Parser {
         self.add_mesh(c, mesh);
     }
 
-    /// Adds a mesh in object space under the current transform and material, without
-    /// its degenerate triangles.
+    /// Adds a mesh in object space under the current transform and material, displaced
+    /// by the current `displacementmap`, without its degenerate triangles.
     fn add_mesh(&mut self, c: &Command, mut mesh: TriangleMesh) {
+        if let Some((texture, scale)) = self.displacement {
+            let tex = &self.desc.textures[texture as usize].texture;
+            match lucent_core::shape::displacement::displace(&mesh, tex, scale) {
+                Ok(m) => mesh = m,
+                Err(e) => {
+                    self.err_cmd(c, format!("{}: displacementmap: {e}", c.name.text));
+                    return;
+                }
+            }
+        }
         let removed = mesh.remove_degenerate();
         if removed > 0 && c.name.text == "mesh" {
             self.warn_cmd(c, format!("mesh: {removed} degenerate triangles (zero area) skipped"));

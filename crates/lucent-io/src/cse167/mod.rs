@@ -65,6 +65,7 @@ const COMMANDS: &[&str] = &[
     "diffusemap",
     "bumpmap",
     "envmap",
+    "displacementmap",
     "maxverts",
     "maxvertnorms",
     "vertex",
@@ -99,7 +100,7 @@ const COMMANDS: &[&str] = &[
 
 /// Commands of lucent's extensions (`../shared/EXTENSIONS.md`) that this version does not
 /// implement yet. Using one is an error, never a silently different picture.
-const NOT_YET_IMPLEMENTED: &[&str] = &["displacementmap"];
+const NOT_YET_IMPLEMENTED: &[&str] = &[];
 
 /// Reads and parses a scene file. A file that cannot be read is an error at `path:1:1`.
 pub fn parse_file(path: &Path, options: ParseOptions) -> (SceneDesc, Diagnostics) {
@@ -215,6 +216,8 @@ struct Parser {
     /// The object being recorded (`objectbegin` without its `objectend` yet), with the
     /// line of its `objectbegin`.
     object: Option<(u32, u32)>,
+    /// `displacementmap`: texture index and scale for the surfaces tessellated next.
+    displacement: Option<(u32, f32)>,
 }
 
 impl Parser {
@@ -239,6 +242,7 @@ impl Parser {
             seen_command: false,
             push_lines: Vec::new(),
             object: None,
+            displacement: None,
         }
     }
 
@@ -395,6 +399,7 @@ impl Parser {
             "texture" | "checker" => self.texture(c),
             "diffusemap" => self.diffuse_map(c),
             "bumpmap" => self.bump_map(c),
+            "displacementmap" => self.displacement_map(c),
             "envmap" => self.environment(c),
             "sphere" => self.sphere(c),
             "plane" | "box" | "cylinder" | "disk" | "cone" | "quadric" => self.analytic(c),
@@ -1004,7 +1009,10 @@ impl Parser {
             let index = self.desc.nurbs.len() as u32;
             self.desc.nurbs.push(p.surface);
             self.desc.shapes.push(ShapeDesc {
-                kind: ShapeKind::Nurbs { index },
+                kind: ShapeKind::Nurbs {
+                    index,
+                    displacement: self.displacement,
+                },
                 transform: p.transform,
                 material: p.material,
                 object: self.object.map(|(o, _)| o),

@@ -118,6 +118,26 @@ impl Parser {
         self.material_id = None;
     }
 
+    /// `displacementmap name scale` or `displacementmap off`: parser state, not part of
+    /// the material; it applies to the meshes, subdivision surfaces, patches and NURBS
+    /// that follow.
+    pub(super) fn displacement_map(&mut self, c: &Command) {
+        if c.args.len() == 1 && c.args[0].text == "off" {
+            self.displacement = None;
+            return;
+        }
+        if !self.expect_count(c, 2, "a texture name and a scale, or 'off'") {
+            return;
+        }
+        let Some(scale) = self.number(c, &c.args[1]) else {
+            return;
+        };
+        let Some(texture) = self.texture_named(c, 0) else {
+            return;
+        };
+        self.displacement = Some((texture, scale as f32));
+    }
+
     /// `envmap file [intensity]`.
     pub(super) fn environment(&mut self, c: &Command) {
         if c.args.is_empty() || c.args.len() > 2 {
