@@ -188,8 +188,16 @@ fn mesh_errors_point_at_the_command() {
     );
     assert_eq!(
         one("mesh textured.obj"),
-        ["3:6: error: mesh: material 'wood' has a diffuse texture (map_Kd wood.png), and textures are not implemented yet"]
+        [format!(
+            "3:6: error: mesh: material 'wood': map_Kd {}: cannot open: no such file",
+            dir.path("wood.png")
+        )]
     );
+    image::RgbImage::from_raw(1, 1, vec![255, 128, 0])
+        .unwrap()
+        .save(dir.0.join("wood.png"))
+        .unwrap();
+    assert!(one("mesh textured.obj").is_empty(), "map_Kd loads relative to the OBJ");
     assert_eq!(
         one("mesh nomtl.obj"),
         [format!(

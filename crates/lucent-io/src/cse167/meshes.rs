@@ -7,9 +7,14 @@ use lucent_core::mesh::TriangleMesh;
 use lucent_core::shape::parametric::grid_mesh;
 use lucent_core::shape::subdivision::{self, Scheme};
 
+use std::path::Path;
+
+use lucent_core::texture::Texture;
+
 use super::{io_reason, Command, Parser};
-use crate::desc::{MaterialDesc, ShapeKind};
+use crate::desc::{MaterialDesc, ShapeKind, TextureDesc};
 use crate::mesh_file::{load_mesh, load_polygons, LoadedMesh, NO_MATERIAL};
+use crate::texture_file::load_image;
 
 /// Subdivision levels `subdivmesh` accepts: every level multiplies the faces by four.
 const MAX_SUBDIVISION_LEVEL: i64 = 8;
@@ -34,15 +39,17 @@ impl Parser {
             let loc = self.loc(c.line, &c.args[0]);
             self.diags.warning(loc, format!("mesh: {}: {w}", path.display()));
         }
-        let Some(mesh) = self.with_scene_materials(c, loaded) else {
+        let mesh_dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let Some(mesh) = self.with_scene_materials(c, loaded, &mesh_dir) else {
             return;
         };
         self.add_mesh(c, mesh);
     }
 
     /// The mesh with its MTL materials turned into scene materials: each is the current
-    /// material with what the MTL sets replaced; faces without one take the current one.
-    fn with_scene_materials(&mut self, c: &Command, loaded: LoadedMesh) -> Option<TriangleMesh> {
+    /// material with what the MTL sets replaced (`map_Kd` becomes a diffuse map); faces
+    /// without one take the current one.
+    fn with_scene_materials(&mut self, c: &Command, loaded: LoadedMesh, mesh_dir: &Path) -> Option<TriangleMesh> {
         let LoadedMesh { mut mesh, library, .. } = loaded;
         if mesh.materials.is_empty() {
             return Some(mesh);
@@ -50,17 +57,6 @@ impl Parser {
         let current = self.material_id();
         let mut ids = Vec::with_capacity(library.len());
         for m in &library {
-            if let Some(t) = &m.diffuse_texture {
-                self.err_arg(
-                    c,
-                    0,
-                    format!(
-                        "mesh: material '{}' has a diffuse texture (map_Kd {t}), and textures are not implemented yet",
-                        m.name
-                    ),
-                );
-                return None;
-            }
             let mut d: MaterialDesc = self.material;
             let rgb = |v: [f32; 3]| glam::Vec3A::from_array(v);
             if let Some(v) = m.diffuse {
@@ -74,6 +70,31 @@ impl Parser {
             }
             if let Some(v) = m.shininess {
                 d.base.shininess = v;
+            }
+            if let Some(file) = &m.diffuse_texture {
+                // map_Kd: relative to the OBJ file, loaded once per scene.
+                let path = mesh_dir.join(file);
+                let name = format!("map_Kd:{}", path.display());
+                let index = match self.desc.textures.iter().position(|t| t.name == name) {
+                    Some(i) => i,
+                    None => match load_image(&path) {
+                        Ok(img) => {
+                            let loc = self.loc(c.line, &c.args[0]);
+                            self.desc.textures.push(TextureDesc {
+                                name,
+                                texture: Texture::Image(img),
+                                loc,
+                            });
+                            self.desc.textures.len() - 1
+                        }
+                        Err(e) => {
+                            let msg = format!("mesh: material '{}': map_Kd {}: {e}", m.name, path.display());
+                            self.err_arg(c, 0, msg);
+                            return None;
+                        }
+                    },
+                };
+                d.base.diffuse_map = Some(index as u32);
             }
             self.desc.materials.push(d);
             ids.push(self.desc.materials.len() as u32 - 1);
