@@ -3,28 +3,14 @@
 //! renderer's own code, and compared byte for byte (±1 for f32 rounding at a truncation
 //! boundary). Pixels whose ray grazes a silhouette or a shadow edge are skipped.
 
+mod common;
+
 use glam::{DMat3, DVec3};
 use lucent_core::accel::AccelKind;
-use lucent_core::render::{render, RenderControl};
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_bytes, ParseOptions};
-use std::sync::atomic::AtomicBool;
 
 fn render_bytes(text: &str, accel: AccelKind, threads: usize) -> (u32, u32, Vec<u8>) {
-    let (desc, mut diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions::default());
-    let built =
-        build(&desc, &BuildOptions { accel }, &mut diags).unwrap_or_else(|| panic!("{}", diags.render(&desc.sources)));
-    assert!(!diags.has_errors());
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    let cancel = AtomicBool::new(false);
-    let control = RenderControl {
-        progress: &|_| {},
-        cancel: &cancel,
-    };
-    let (film, _) = pool
-        .install(|| render(&built.scene, built.integrator.as_ref(), &control))
-        .unwrap();
-    (film.width, film.height, film.to_rgb8(built.gamma))
+    let (film, gamma) = common::render_scene("t.test", text, accel, threads);
+    (film.width, film.height, film.to_rgb8(gamma))
 }
 
 fn pixel(img: &(u32, u32, Vec<u8>), x: u32, y: u32) -> [u8; 3] {

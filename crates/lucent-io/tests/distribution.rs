@@ -3,28 +3,12 @@
 //! against what can be worked out by hand, and all of them the same bytes for any
 //! thread count.
 
-use std::sync::atomic::AtomicBool;
+mod common;
 
 use lucent_core::accel::AccelKind;
-use lucent_core::render::{render, RenderControl};
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_bytes, ParseOptions};
 
 fn render_bytes(text: &str, threads: usize) -> Vec<u8> {
-    let (desc, mut diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions::default());
-    let built = build(&desc, &BuildOptions { accel: AccelKind::Bvh }, &mut diags)
-        .unwrap_or_else(|| panic!("{}", diags.render(&desc.sources)));
-    assert!(!diags.has_errors(), "{}", diags.render(&desc.sources));
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    let cancel = AtomicBool::new(false);
-    let control = RenderControl {
-        progress: &|_| {},
-        cancel: &cancel,
-    };
-    let (film, _) = pool
-        .install(|| render(&built.scene, built.integrator.as_ref(), &control))
-        .unwrap();
-    film.to_rgb8(built.gamma)
+    common::render_rgb8("t.test", text, AccelKind::Bvh, threads)
 }
 
 /// An emissive rectangle `x0..x1 × y0..y1` in the plane z = 0, seen from +z.

@@ -2,45 +2,17 @@
 //! at its command, and the geometry they make renders exactly like the same triangles
 //! and shapes written out by hand, with every acceleration structure.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
+mod common;
+
+use common::TempDir;
+use std::path::Path;
 
 use lucent_core::accel::AccelKind;
-use lucent_core::render::{render, RenderControl};
 use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_bytes, ParseOptions};
 use lucent_io::diag::Severity;
 
 const HEADER: &str = "size 48 36\ncamera 0 0 6 0 0 0 0 1 0 45\n";
-
-/// A folder of its own for each test, removed when the test ends.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("lucent-meshes-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-
-    fn write(&self, name: &str, text: &str) {
-        std::fs::write(self.0.join(name), text).unwrap();
-    }
-
-    fn scene(&self) -> String {
-        self.0.join("s.test").display().to_string()
-    }
-
-    fn path(&self, name: &str) -> String {
-        self.0.join(name).display().to_string()
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
 
 /// `line:col: severity: message` for every diagnostic of parse and build.
 fn diagnostics(scene: &str, text: &str) -> Vec<String> {
@@ -57,17 +29,7 @@ fn diagnostics(scene: &str, text: &str) -> Vec<String> {
 }
 
 fn render_bytes(scene: &str, text: &str, accel: AccelKind) -> Vec<u8> {
-    let (desc, mut diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
-    let built =
-        build(&desc, &BuildOptions { accel }, &mut diags).unwrap_or_else(|| panic!("{}", diags.render(&desc.sources)));
-    assert!(!diags.has_errors(), "{}", diags.render(&desc.sources));
-    let cancel = AtomicBool::new(false);
-    let control = RenderControl {
-        progress: &|_| {},
-        cancel: &cancel,
-    };
-    let (film, _) = render(&built.scene, built.integrator.as_ref(), &control).unwrap();
-    film.to_rgb8(built.gamma)
+    common::render_rgb8(scene, text, accel, 1)
 }
 
 const LIGHTS: &str = "ambient 0 0 0\npoint 2 3 6 1 1 1\ndirectional -1 1 1 0.3 0.3 0.3\n";

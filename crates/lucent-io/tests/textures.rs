@@ -1,45 +1,16 @@
 //! `texture`, `checker`, `diffusemap`, `bumpmap` and `envmap`, rendered, with values
 //! worked out by hand; and their errors, located.
 
-use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+mod common;
+
+use common::TempDir;
 
 use lucent_core::accel::AccelKind;
-use lucent_core::render::{render, RenderControl};
-use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_bytes, ParseOptions};
 use lucent_io::diag::Severity;
 
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(name: &str) -> TempDir {
-        let dir = std::env::temp_dir().join(format!("lucent-textures-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-    fn scene(&self) -> String {
-        self.0.join("s.test").display().to_string()
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
 fn render_film(scene: &str, text: &str) -> Vec<[f32; 3]> {
-    let (desc, mut diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
-    let built = build(&desc, &BuildOptions { accel: AccelKind::Bvh }, &mut diags)
-        .unwrap_or_else(|| panic!("{}", diags.render(&desc.sources)));
-    assert!(!diags.has_errors(), "{}", diags.render(&desc.sources));
-    let cancel = AtomicBool::new(false);
-    let control = RenderControl {
-        progress: &|_| {},
-        cancel: &cancel,
-    };
-    let (film, _) = render(&built.scene, built.integrator.as_ref(), &control).unwrap();
+    let (film, _) = common::render_scene(scene, text, AccelKind::Bvh, 1);
     film.pixels.iter().map(|p| p.to_array()).collect()
 }
 

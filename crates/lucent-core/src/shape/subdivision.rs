@@ -113,6 +113,25 @@ fn boundary_vertex(v: DVec3, rim: &[u32], p: &[DVec3]) -> DVec3 {
     }
 }
 
+/// The new positions of the old vertices: the boundary rule on the rim, isolated
+/// vertices left alone, and the scheme's `interior` rule elsewhere.
+fn vertex_points<'a>(
+    p: &'a [DVec3],
+    all: &'a [Vec<u32>],
+    rim: &'a [Vec<u32>],
+    interior: impl Fn(usize, DVec3) -> DVec3 + 'a,
+) -> impl Iterator<Item = DVec3> + 'a {
+    p.iter().enumerate().map(move |(v, &pos)| {
+        if !rim[v].is_empty() {
+            boundary_vertex(pos, &rim[v], p)
+        } else if all[v].is_empty() {
+            pos
+        } else {
+            interior(v, pos)
+        }
+    })
+}
+
 fn loop_beta(n: usize) -> f64 {
     let n = n as f64;
     let c = 0.375 + 0.25 * (2.0 * PI / n).cos();
@@ -124,18 +143,12 @@ fn loop_step(m: &ControlMesh) -> Result<ControlMesh, String> {
     let p = &m.positions;
     let (all, rim) = neighbours(p.len(), &t);
     let mut out = Vec::with_capacity(p.len() + t.ends.len());
-    for (v, &pos) in p.iter().enumerate() {
-        out.push(if !rim[v].is_empty() {
-            boundary_vertex(pos, &rim[v], p)
-        } else if all[v].is_empty() {
-            pos
-        } else {
-            let n = all[v].len();
-            let beta = loop_beta(n);
-            let sum: DVec3 = all[v].iter().map(|&u| p[u as usize]).sum();
-            (1.0 - n as f64 * beta) * pos + beta * sum
-        });
-    }
+    out.extend(vertex_points(p, &all, &rim, |v, pos| {
+        let n = all[v].len();
+        let beta = loop_beta(n);
+        let sum: DVec3 = all[v].iter().map(|&u| p[u as usize]).sum();
+        (1.0 - n as f64 * beta) * pos + beta * sum
+    }));
     let opposite = |f: u32, a: u32, b: u32| -> DVec3 {
         let face = &m.faces[f as usize];
         let c = face.iter().find(|&&x| x != a && x != b).expect("a triangle");
@@ -176,18 +189,12 @@ fn catmull_clark_step(m: &ControlMesh) -> Result<ControlMesh, String> {
         }
     }
     let mut out = Vec::with_capacity(p.len() + t.ends.len() + m.faces.len());
-    for (v, &pos) in p.iter().enumerate() {
-        out.push(if !rim[v].is_empty() {
-            boundary_vertex(pos, &rim[v], p)
-        } else if all[v].is_empty() {
-            pos
-        } else {
-            let n = all[v].len() as f64;
-            let q = faces_of[v].iter().map(|&f| centroid[f as usize]).sum::<DVec3>() / faces_of[v].len() as f64;
-            let r = all[v].iter().map(|&u| 0.5 * (pos + p[u as usize])).sum::<DVec3>() / n;
-            (q + 2.0 * r + (n - 3.0) * pos) / n
-        });
-    }
+    out.extend(vertex_points(p, &all, &rim, |v, pos| {
+        let n = all[v].len() as f64;
+        let q = faces_of[v].iter().map(|&f| centroid[f as usize]).sum::<DVec3>() / faces_of[v].len() as f64;
+        let r = all[v].iter().map(|&u| 0.5 * (pos + p[u as usize])).sum::<DVec3>() / n;
+        (q + 2.0 * r + (n - 3.0) * pos) / n
+    }));
     for (e, &[a, b]) in t.ends.iter().enumerate() {
         let (pa, pb) = (p[a as usize], p[b as usize]);
         out.push(if t.is_boundary(e) {

@@ -14,14 +14,7 @@ impl Parser {
             return;
         }
         let name = c.args[0].text;
-        if let Some((open, line)) = self.object {
-            let open = &self.desc.objects[open as usize].name;
-            self.err_cmd(
-                c,
-                format!(
-                    "objectbegin: objects cannot be nested (object '{open}' begun on line {line} has no objectend yet)"
-                ),
-            );
+        if self.refused_inside_object(c, "objects cannot be nested", "has no objectend yet") {
             return;
         }
         if let Some(o) = self.desc.objects.iter().find(|o| o.name == name) {
@@ -60,14 +53,7 @@ impl Parser {
             return;
         }
         let name = c.args[0].text;
-        if let Some((open, line)) = self.object {
-            let open = &self.desc.objects[open as usize].name;
-            self.err_cmd(
-                c,
-                format!(
-                    "instance: objects cannot contain instances (object '{open}' begun on line {line} is still open)"
-                ),
-            );
+        if self.refused_inside_object(c, "objects cannot contain instances", "is still open") {
             return;
         }
         let Some(object) = self.desc.objects.iter().position(|o| o.name == name) else {
@@ -81,6 +67,18 @@ impl Parser {
             return;
         };
         self.shape(c, ShapeKind::Instance { object: object as u32 });
+    }
+
+    /// An error if an object is being recorded: `command: why (object 'a' begun on line
+    /// N state)`.
+    fn refused_inside_object(&mut self, c: &Command, why: &str, state: &str) -> bool {
+        let Some((open, line)) = self.object else {
+            return false;
+        };
+        let open = &self.desc.objects[open as usize].name;
+        let msg = format!("{}: {why} (object '{open}' begun on line {line} {state})", c.name.text);
+        self.err_cmd(c, msg);
+        true
     }
 
     /// At the end of the file: an object still open is an error at its `objectbegin`.
