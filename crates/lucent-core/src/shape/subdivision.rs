@@ -132,6 +132,22 @@ fn vertex_points<'a>(
     })
 }
 
+/// The new points on the old edges: midpoints on the boundary, the scheme's `interior`
+/// rule (given the edge's ends and its two faces) elsewhere.
+fn edge_points<'a>(
+    p: &'a [DVec3],
+    t: &'a Topology,
+    interior: impl Fn(u32, u32, [u32; 2]) -> DVec3 + 'a,
+) -> impl Iterator<Item = DVec3> + 'a {
+    t.ends.iter().enumerate().map(move |(e, &[a, b])| {
+        if t.is_boundary(e) {
+            0.5 * (p[a as usize] + p[b as usize])
+        } else {
+            interior(a, b, t.faces[e])
+        }
+    })
+}
+
 fn loop_beta(n: usize) -> f64 {
     let n = n as f64;
     let c = 0.375 + 0.25 * (2.0 * PI / n).cos();
@@ -154,15 +170,9 @@ fn loop_step(m: &ControlMesh) -> Result<ControlMesh, String> {
         let c = face.iter().find(|&&x| x != a && x != b).expect("a triangle");
         p[*c as usize]
     };
-    for (e, &[a, b]) in t.ends.iter().enumerate() {
-        let (pa, pb) = (p[a as usize], p[b as usize]);
-        out.push(if t.is_boundary(e) {
-            0.5 * (pa + pb)
-        } else {
-            let [f0, f1] = t.faces[e];
-            0.375 * (pa + pb) + 0.125 * (opposite(f0, a, b) + opposite(f1, a, b))
-        });
-    }
+    out.extend(edge_points(p, &t, |a, b, [f0, f1]| {
+        0.375 * (p[a as usize] + p[b as usize]) + 0.125 * (opposite(f0, a, b) + opposite(f1, a, b))
+    }));
     let base = p.len() as u32;
     let mut faces = Vec::with_capacity(m.faces.len() * 4);
     for f in &m.faces {
@@ -195,15 +205,9 @@ fn catmull_clark_step(m: &ControlMesh) -> Result<ControlMesh, String> {
         let r = all[v].iter().map(|&u| 0.5 * (pos + p[u as usize])).sum::<DVec3>() / n;
         (q + 2.0 * r + (n - 3.0) * pos) / n
     }));
-    for (e, &[a, b]) in t.ends.iter().enumerate() {
-        let (pa, pb) = (p[a as usize], p[b as usize]);
-        out.push(if t.is_boundary(e) {
-            0.5 * (pa + pb)
-        } else {
-            let [f0, f1] = t.faces[e];
-            0.25 * (pa + pb + centroid[f0 as usize] + centroid[f1 as usize])
-        });
-    }
+    out.extend(edge_points(p, &t, |a, b, [f0, f1]| {
+        0.25 * (p[a as usize] + p[b as usize] + centroid[f0 as usize] + centroid[f1 as usize])
+    }));
     out.extend(&centroid);
     let edge_base = p.len() as u32;
     let face_base = edge_base + t.ends.len() as u32;
