@@ -98,10 +98,6 @@ const COMMANDS: &[&str] = &[
     "gamma",
 ];
 
-/// Commands of lucent's extensions (`../shared/EXTENSIONS.md`) that this version does not
-/// implement yet. Using one is an error, never a silently different picture.
-const NOT_YET_IMPLEMENTED: &[&str] = &[];
-
 /// Reads and parses a scene file. A file that cannot be read is an error at `path:1:1`.
 pub fn parse_file(path: &Path, options: ParseOptions) -> (SceneDesc, Diagnostics) {
     match std::fs::read(path) {
@@ -647,12 +643,6 @@ impl Parser {
                     };
                     self.set_global(c, |d| &mut d.gamma, v);
                 }
-            }
-            name if NOT_YET_IMPLEMENTED.contains(&name) => {
-                self.err_cmd(
-                    c,
-                    format!("{name}: this lucent extension (docs/scene-format.md) is not implemented yet"),
-                );
             }
             name => {
                 let hint = suggestion(name).map_or(String::new(), |s| format!("; did you mean '{s}'?"));
@@ -1389,11 +1379,7 @@ impl Parser {
 /// two edits away.
 fn suggestion(name: &str) -> Option<&'static str> {
     let lower = name.to_lowercase();
-    if let Some(c) = COMMANDS
-        .iter()
-        .chain(NOT_YET_IMPLEMENTED)
-        .find(|c| c.to_lowercase() == lower)
-    {
+    if let Some(c) = COMMANDS.iter().find(|c| c.to_lowercase() == lower) {
         return Some(c);
     }
     COMMANDS
