@@ -99,5 +99,24 @@ pub fn run(args: &CheckArgs) -> u8 {
         lights(&|k| matches!(k, LightKind::Quad { .. }))
     );
     println!("materials:  {}", desc.materials.len());
+    let spp = desc.spp.as_ref().map_or(1, |s| s.value);
+    let samples = desc.light_samples.as_ref().map_or(1, |s| s.value);
+    let stratified = desc.light_stratify.as_ref().is_some_and(|s| s.value);
+    let lens = desc.lens.as_ref().map_or(String::new(), |l| {
+        format!(", lens aperture {} focus {}", l.value.0, l.value.1)
+    });
+    println!(
+        "sampling:   spp {spp}, lightsamples {samples}{}{lens}",
+        if stratified { " (stratified)" } else { "" }
+    );
+    println!(
+        "textures:   {}{}",
+        desc.textures.len(),
+        if desc.environment.is_some() {
+            ", and an environment map"
+        } else {
+            ""
+        }
+    );
     0
 }
