@@ -88,8 +88,12 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut stats = RenderStats::default();
     let n = scene.samples_per_pixel.max(1);
+    let mut lens_strata: Vec<u32> = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
+            if scene.camera.has_lens() {
+                lens_strata = shuffled_strata(x, y, n, lens_strata);
+            }
             let mut sum = Color::ZERO;
             for i in 0..n {
                 let mut sampler = Sampler::new(x, y, i);
@@ -102,8 +106,10 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<
                     stratified(i, n, u, v)
                 };
                 let lens = if scene.camera.has_lens() {
+                    // The lens strata in another order than the pixel's, so that where a
+                    // sample falls in the pixel says nothing about where it leaves the lens.
                     let (u, v) = sampler.uniform2();
-                    stratified(i, n, u, v)
+                    stratified(lens_strata[i as usize], n, u, v)
                 } else {
                     (0.5, 0.5)
                 };
@@ -120,4 +126,32 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<
         }
     }
     (pixels, stats)
+}
+
+/// `0..n` in an order drawn from the pixel alone (Fisher–Yates), reusing `out`'s storage.
+fn shuffled_strata(x: u32, y: u32, n: u32, mut out: Vec<u32>) -> Vec<u32> {
+    out.clear();
+    out.extend(0..n);
+    let mut rng = Sampler::new(x, y, u32::MAX);
+    for i in (1..n as usize).rev() {
+        let j = ((rng.uniform() * (i + 1) as f32) as usize).min(i);
+        out.swap(i, j);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lens_strata_are_a_permutation_fixed_by_the_pixel() {
+        let a = shuffled_strata(3, 7, 16, Vec::new());
+        let mut sorted = a.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..16).collect::<Vec<_>>());
+        assert_eq!(a, shuffled_strata(3, 7, 16, vec![9; 40]));
+        assert_ne!(a, (0..16).collect::<Vec<_>>(), "not the pixel strata's order");
+        assert_ne!(a, shuffled_strata(4, 7, 16, Vec::new()));
+    }
 }
