@@ -1,6 +1,8 @@
 //! Every malformed-scene case gets an exact `file:line:col` message. Each case is a
 //! scene with a valid header plus one bad line (line 3).
 
+mod common;
+
 use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_bytes, ParseOptions};
 use lucent_io::diag::Severity;
@@ -436,16 +438,7 @@ fn bezier_patch_files() {
     .unwrap();
     let scene = dir.join("s.test");
     let name = scene.display().to_string();
-    let errors = |line: &str| -> Vec<String> {
-        let text = format!("{HEADER}{line}\n");
-        let (_, diags) = parse_bytes(&name, text.as_bytes(), ParseOptions::default());
-        diags
-            .items
-            .iter()
-            .filter(|d| d.severity == Severity::Error)
-            .map(|d| format!("{}:{}: {}", d.loc.line, d.loc.col, d.message))
-            .collect()
-    };
+    let errors = |line: &str| common::parse_errors(&name, &format!("{HEADER}{line}\n"));
     let bad = dir.join("bad.bpt").display().to_string();
     let missing = dir.join("missing.bpt").display().to_string();
     assert_eq!(

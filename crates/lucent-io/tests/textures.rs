@@ -6,8 +6,6 @@ mod common;
 use common::TempDir;
 
 use lucent_core::accel::AccelKind;
-use lucent_io::cse167::{parse_bytes, ParseOptions};
-use lucent_io::diag::Severity;
 
 fn render_film(scene: &str, text: &str) -> Vec<[f32; 3]> {
     let (film, _) = common::render_scene(scene, text, AccelKind::Bvh, 1);
@@ -15,13 +13,7 @@ fn render_film(scene: &str, text: &str) -> Vec<[f32; 3]> {
 }
 
 fn errors(scene: &str, text: &str) -> Vec<String> {
-    let (_, diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
-    diags
-        .items
-        .iter()
-        .filter(|d| d.severity == Severity::Error)
-        .map(|d| format!("{}:{}: {}", d.loc.line, d.loc.col, d.message))
-        .collect()
+    common::parse_errors(scene, text)
 }
 
 /// A unit square `[0, 1]²` in z = 0 facing +z, its texture coordinates its x and y (two

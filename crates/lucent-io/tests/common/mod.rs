@@ -67,3 +67,15 @@ pub fn render_rgb8(scene: &str, text: &str, accel: lucent_core::accel::AccelKind
     let (film, gamma) = render_scene(scene, text, accel, threads);
     film.to_rgb8(gamma)
 }
+
+/// `line:col: message` of every error the parser reports (the build is not run).
+pub fn parse_errors(scene: &str, text: &str) -> Vec<String> {
+    use lucent_io::cse167::{parse_bytes, ParseOptions};
+    let (_, diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
+    diags
+        .items
+        .iter()
+        .filter(|d| d.severity == lucent_io::diag::Severity::Error)
+        .map(|d| format!("{}:{}: {}", d.loc.line, d.loc.col, d.message))
+        .collect()
+}
