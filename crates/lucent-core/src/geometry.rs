@@ -31,9 +31,9 @@ impl Geometry {
 
     #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        let mut best = self.accel.closest_hit(&self.primitives, ray);
+        let r = PreparedRay::new(*ray);
+        let mut best = self.accel.closest_hit(&self.primitives, &r);
         if !self.unbounded.is_empty() {
-            let r = PreparedRay::new(*ray);
             for &i in &self.unbounded {
                 let t_max = best.map_or(ray.t_max, |b| b.t);
                 if let Some(hit) = self.primitives[i as usize].intersect(i, &r, t_max) {
@@ -49,17 +49,11 @@ impl Geometry {
 
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if !self.unbounded.is_empty() {
-            let r = PreparedRay::new(*ray);
-            if self
-                .unbounded
-                .iter()
-                .any(|&i| self.primitives[i as usize].occludes(&r, ray.t_max))
-            {
-                return true;
-            }
-        }
-        self.accel.occluded(&self.primitives, ray)
+        let r = PreparedRay::new(*ray);
+        self.unbounded
+            .iter()
+            .any(|&i| self.primitives[i as usize].occludes(&r, ray.t_max))
+            || self.accel.occluded(&self.primitives, &r)
     }
 
     /// World-space `∂p/∂u`, `∂p/∂v` at `hit` (see [`Primitive::tangents`]).

@@ -13,7 +13,7 @@ use crate::aabb::Aabb;
 use crate::accel::{AccelKind, Accelerator, PrimitiveSet};
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Vec3, Vec3A};
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 use crate::shape::triangle;
 use glam::Vec2;
 
@@ -228,12 +228,12 @@ impl MeshShape {
     /// The closest hit in `(t_min, t_max]`: `prim` is the triangle.
     #[inline]
     pub fn intersect(&self, ray: &PreparedRay, t_max: f32) -> Option<Hit> {
-        self.accel.closest_hit(&self.mesh, &Ray { t_max, ..ray.ray })
+        self.accel.closest_hit(&self.mesh, &ray.with_t_max(t_max))
     }
 
     #[inline]
     pub fn occludes(&self, ray: &PreparedRay, t_max: f32) -> bool {
-        self.accel.occluded(&self.mesh, &Ray { t_max, ..ray.ray })
+        self.accel.occluded(&self.mesh, &ray.with_t_max(t_max))
     }
 
     /// The structure over the triangles (not the vertex data).
@@ -245,6 +245,7 @@ impl MeshShape {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::ray::Ray;
 
     fn quad() -> TriangleMesh {
         TriangleMesh {

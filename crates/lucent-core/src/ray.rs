@@ -67,6 +67,14 @@ pub struct PreparedRay {
 }
 
 impl PreparedRay {
+    /// The same ray with another far limit (what a structure inside a primitive is asked).
+    #[inline(always)]
+    pub fn with_t_max(&self, t_max: f32) -> PreparedRay {
+        let mut r = *self;
+        r.ray.t_max = t_max;
+        r
+    }
+
     pub fn new(ray: Ray) -> PreparedRay {
         let d = ray.dir;
         // One vector division; the rare zero or subnormal components are fixed after.

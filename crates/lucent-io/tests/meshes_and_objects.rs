@@ -8,24 +8,12 @@ use common::TempDir;
 use std::path::Path;
 
 use lucent_core::accel::AccelKind;
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_bytes, ParseOptions};
-use lucent_io::diag::Severity;
 
 const HEADER: &str = "size 48 36\ncamera 0 0 6 0 0 0 0 1 0 45\n";
 
 /// `line:col: severity: message` for every diagnostic of parse and build.
 fn diagnostics(scene: &str, text: &str) -> Vec<String> {
-    let (desc, mut diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
-    if !diags.has_errors() {
-        build(&desc, &BuildOptions::default(), &mut diags);
-    }
-    diags
-        .items
-        .iter()
-        .filter(|d| d.severity != Severity::Note)
-        .map(|d| format!("{}:{}: {}: {}", d.loc.line, d.loc.col, d.severity, d.message))
-        .collect()
+    common::diagnostics(scene, text, false)
 }
 
 fn render_bytes(scene: &str, text: &str, accel: AccelKind) -> Vec<u8> {
@@ -273,7 +261,8 @@ fn object_errors_point_at_the_command() {
 fn the_shipped_mesh_scenes_parse_without_a_word() {
     let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     for name in ["meshes.test", "instances.test", "subdivision.test"] {
-        let (desc, diags) = lucent_io::cse167::parse_file(&scenes.join(name), ParseOptions { strict: true });
+        let (desc, diags) =
+            lucent_io::cse167::parse_file(&scenes.join(name), lucent_io::cse167::ParseOptions { strict: true });
         assert!(diags.items.is_empty(), "{name}: {}", diags.render(&desc.sources));
     }
 }

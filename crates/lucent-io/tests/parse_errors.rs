@@ -3,28 +3,16 @@
 
 mod common;
 
-use lucent_io::build::{build, BuildOptions};
 use lucent_io::cse167::{parse_bytes, ParseOptions};
-use lucent_io::diag::Severity;
 
 const HEADER: &str = "size 64 48\ncamera 0 0 5 0 0 0 0 1 0 45\n";
 
 /// The first line of every error and warning (parse and build), in order.
 fn messages(text: &str, strict: bool) -> Vec<String> {
-    let (desc, mut diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions { strict });
-    if !diags.has_errors() {
-        build(&desc, &BuildOptions::default(), &mut diags);
-    }
-    diags
-        .items
-        .iter()
-        .filter(|d| d.severity != Severity::Note)
-        .map(|d| diags_line(&d.severity.to_string(), d.loc.line, d.loc.col, &d.message))
+    common::diagnostics("t.test", text, strict)
+        .into_iter()
+        .map(|m| format!("t.test:{m}"))
         .collect()
-}
-
-fn diags_line(sev: &str, line: u32, col: u32, msg: &str) -> String {
-    format!("t.test:{line}:{col}: {sev}: {msg}")
 }
 
 fn first_error(bad_line: &str) -> String {

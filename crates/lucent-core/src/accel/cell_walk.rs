@@ -5,29 +5,45 @@
 //! with the scene-order tie rule, and stop once it lies before the next cell.
 
 use super::mailbox::Mailbox;
-use super::{search_limit, PrimitiveSet};
+use super::{search_limit, Accelerator, PrimitiveSet};
 use crate::hit::Hit;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 
 pub trait CellWalk {
     /// Visits the cells `ray` crosses, nearest first. `cell` gets a cell's primitives and
     /// returns the distance beyond which nothing more can be found; `None` stops the walk.
-    fn walk(&self, ray: &Ray, cell: impl FnMut(&[u32]) -> Option<f32>);
+    fn walk(&self, r: &PreparedRay, cell: impl FnMut(&[u32]) -> Option<f32>);
     /// One more than the largest primitive index the cells hold (the mailbox's size).
     fn prim_count(&self) -> usize;
+    /// Bytes of the cells and their primitive lists.
+    fn memory_bytes(&self) -> usize;
 }
 
-pub fn closest_hit<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, ray: &Ray) -> Option<Hit> {
-    let r = PreparedRay::new(*ray);
+/// Every cell walk is a structure: the queries are the same for all of them.
+impl<W: CellWalk + Send + Sync, P: PrimitiveSet + ?Sized> Accelerator<P> for W {
+    fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
+        closest_hit(self, prims, r)
+    }
+
+    fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {
+        occluded(self, prims, r)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        CellWalk::memory_bytes(self)
+    }
+}
+
+pub fn closest_hit<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, r: &PreparedRay) -> Option<Hit> {
     let mut best: Option<Hit> = None;
-    let mut t_max = ray.t_max;
+    let mut t_max = r.ray.t_max;
     Mailbox::with(w.prim_count(), |mailbox| {
-        w.walk(ray, |ids| {
+        w.walk(r, |ids| {
             for &pi in ids {
                 if !mailbox.first_visit(pi) {
                     continue;
                 }
-                if let Some(hit) = prims.intersect(pi, &r, t_max) {
+                if let Some(hit) = prims.intersect(pi, r, t_max) {
                     if Hit::is_closer_than(hit.t, pi, &best) {
                         best = Some(hit);
                         t_max = hit.t;
@@ -40,14 +56,13 @@ pub fn closest_hit<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, ray: 
     best
 }
 
-pub fn occluded<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, ray: &Ray) -> bool {
-    let r = PreparedRay::new(*ray);
+pub fn occluded<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, r: &PreparedRay) -> bool {
     let mut hit = false;
     Mailbox::with(w.prim_count(), |mailbox| {
-        w.walk(ray, |ids| {
+        w.walk(r, |ids| {
             hit = ids
                 .iter()
-                .any(|&pi| mailbox.first_visit(pi) && prims.occludes(pi, &r, ray.t_max));
+                .any(|&pi| mailbox.first_visit(pi) && prims.occludes(pi, r, r.ray.t_max));
             (!hit).then_some(f32::INFINITY)
         })
     });

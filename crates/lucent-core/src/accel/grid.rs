@@ -11,13 +11,12 @@
 //! ends when the closest hit lies inside the current cell. Mailboxing ([`Mailbox`])
 //! tests a primitive that spans several cells once per ray.
 
-use super::cell_walk::{self, CellWalk};
+use super::cell_walk::CellWalk;
 use super::overlap::{cell_padding, overlaps, padded};
-use super::{search_limit, Accelerator, PrimitiveSet};
+use super::{search_limit, PrimitiveSet};
 use crate::aabb::Aabb;
-use crate::hit::Hit;
 use crate::math::Vec3A;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 
 /// Cells per primitive.
 const DENSITY: f32 = 3.0;
@@ -130,12 +129,12 @@ impl Grid {
 
 impl CellWalk for Grid {
     #[inline(always)]
-    fn walk(&self, ray: &Ray, mut cell: impl FnMut(&[u32]) -> Option<f32>) {
+    fn walk(&self, r: &PreparedRay, mut cell: impl FnMut(&[u32]) -> Option<f32>) {
         if self.prim_count == 0 {
             return;
         }
-        let r = PreparedRay::new(*ray);
-        let Some((t0, _)) = self.bounds.intersect(&r, search_limit(ray.t_max)) else {
+        let ray = &r.ray;
+        let Some((t0, _)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
             return;
         };
         let entry = ray.at(t0);
@@ -184,16 +183,6 @@ impl CellWalk for Grid {
 
     fn prim_count(&self) -> usize {
         self.prim_count
-    }
-}
-
-impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Grid {
-    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
-        cell_walk::closest_hit(self, prims, ray)
-    }
-
-    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
-        cell_walk::occluded(self, prims, ray)
     }
 
     fn memory_bytes(&self) -> usize {

@@ -14,12 +14,11 @@
 //! is pushed with its part of the interval; as soon as the closest hit lies before the
 //! entry of the next node to visit, the search stops.
 
-use super::cell_walk::{self, CellWalk};
+use super::cell_walk::CellWalk;
 use super::overlap::{cell_padding, clipped_bounds, overlaps, padded};
-use super::{search_limit, Accelerator, PrimitiveSet};
+use super::{search_limit, PrimitiveSet};
 use crate::aabb::Aabb;
-use crate::hit::Hit;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 
 const BINS: usize = 32;
 const TRAVERSAL_COST: f32 = 1.0;
@@ -206,12 +205,12 @@ fn best_plane(node_box: &Aabb, items: &[Item]) -> Option<(usize, f32)> {
 
 impl CellWalk for KdTree {
     #[inline(always)]
-    fn walk(&self, ray: &Ray, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
+    fn walk(&self, r: &PreparedRay, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
         if self.nodes.is_empty() {
             return;
         }
-        let r = PreparedRay::new(*ray);
-        let Some((t0, t1)) = self.bounds.intersect(&r, search_limit(ray.t_max)) else {
+        let ray = &r.ray;
+        let Some((t0, t1)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
             return;
         };
         let mut stack = [(0u32, 0.0f32, 0.0f32); STACK_SIZE];
@@ -262,16 +261,6 @@ impl CellWalk for KdTree {
 
     fn prim_count(&self) -> usize {
         self.prim_count
-    }
-}
-
-impl<P: PrimitiveSet + ?Sized> Accelerator<P> for KdTree {
-    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
-        cell_walk::closest_hit(self, prims, ray)
-    }
-
-    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
-        cell_walk::occluded(self, prims, ray)
     }
 
     fn memory_bytes(&self) -> usize {

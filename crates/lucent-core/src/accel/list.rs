@@ -3,7 +3,7 @@
 
 use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 
 pub struct PrimitiveList {
     /// The bounded primitives, in scene order.
@@ -19,12 +19,11 @@ impl PrimitiveList {
 }
 
 impl<P: PrimitiveSet + ?Sized> Accelerator<P> for PrimitiveList {
-    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
-        let r = PreparedRay::new(*ray);
+    fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
         let mut best: Option<Hit> = None;
         for &i in &self.indices {
-            let t_max = best.map_or(ray.t_max, |b| b.t);
-            if let Some(hit) = prims.intersect(i, &r, t_max) {
+            let t_max = best.map_or(r.ray.t_max, |b| b.t);
+            if let Some(hit) = prims.intersect(i, r, t_max) {
                 if Hit::is_closer_than(hit.t, i, &best) {
                     best = Some(hit);
                 }
@@ -33,9 +32,8 @@ impl<P: PrimitiveSet + ?Sized> Accelerator<P> for PrimitiveList {
         best
     }
 
-    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
-        let r = PreparedRay::new(*ray);
-        self.indices.iter().any(|&i| prims.occludes(i, &r, ray.t_max))
+    fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {
+        self.indices.iter().any(|&i| prims.occludes(i, r, r.ray.t_max))
     }
 
     fn memory_bytes(&self) -> usize {

@@ -21,7 +21,7 @@ use crate::aabb::Aabb;
 use crate::hit::Hit;
 use crate::math::Vec3A;
 use crate::primitive::Primitive;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 
 /// How far past the closest hit so far a structure keeps looking.
 ///
@@ -97,9 +97,9 @@ pub fn is_bounded(b: &Aabb) -> bool {
 /// A structure over the primitive set `P` it was built for.
 pub trait Accelerator<P: PrimitiveSet + ?Sized>: Send + Sync {
     /// The closest hit with `ray.t_min < t <= ray.t_max`.
-    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit>;
+    fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit>;
     /// Whether anything lies in `(ray.t_min, ray.t_max]` (shadow rays).
-    fn occluded(&self, prims: &P, ray: &Ray) -> bool;
+    fn occluded(&self, prims: &P, r: &PreparedRay) -> bool;
     /// Bytes used by the structure itself (not counting the primitives).
     fn memory_bytes(&self) -> usize;
 }

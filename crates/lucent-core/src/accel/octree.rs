@@ -12,12 +12,11 @@
 //! its own part of the ray's interval. The search ends when the closest hit lies before
 //! the next octant.
 
-use super::cell_walk::{self, CellWalk};
+use super::cell_walk::CellWalk;
 use super::overlap::{cell_padding, overlaps, padded};
-use super::{search_limit, Accelerator, PrimitiveSet};
+use super::{search_limit, PrimitiveSet};
 use crate::aabb::Aabb;
-use crate::hit::Hit;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 
 const MAX_LEAF: usize = 8;
 const MAX_DEPTH: usize = 16;
@@ -137,12 +136,12 @@ impl Octree {
 
 impl CellWalk for Octree {
     #[inline(always)]
-    fn walk(&self, ray: &Ray, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
+    fn walk(&self, r: &PreparedRay, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
         if self.nodes.is_empty() {
             return;
         }
-        let r = PreparedRay::new(*ray);
-        let Some((t0, t1)) = self.bounds.intersect(&r, search_limit(ray.t_max)) else {
+        let ray = &r.ray;
+        let Some((t0, t1)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
             return;
         };
         // (node, cell, entry, exit), nearest on top.
@@ -207,16 +206,6 @@ impl CellWalk for Octree {
 
     fn prim_count(&self) -> usize {
         self.prim_count
-    }
-}
-
-impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Octree {
-    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
-        cell_walk::closest_hit(self, prims, ray)
-    }
-
-    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
-        cell_walk::occluded(self, prims, ray)
     }
 
     fn memory_bytes(&self) -> usize {

@@ -7,7 +7,7 @@ use super::test_scenes::{analytic_soup, coplanar_grid, soup, Rng};
 use super::{AccelKind, Accelerator};
 use crate::math::Vec3A;
 use crate::primitive::{Primitive, Shape};
-use crate::ray::Ray;
+use crate::ray::{PreparedRay, Ray};
 
 type Named = (String, Box<dyn Accelerator<[Primitive]>>);
 
@@ -37,17 +37,20 @@ fn check_against_list(prims: &[Primitive], rays: &[Ray]) -> usize {
     let list = PrimitiveList::new(prims);
     let expected: Vec<_> = rays
         .iter()
-        .map(|r| (list.closest_hit(prims, r), list.occluded(prims, r)))
+        .map(|r| {
+            let r = PreparedRay::new(*r);
+            (list.closest_hit(prims, &r), list.occluded(prims, &r))
+        })
         .collect();
     for (name, accel) in structures(prims) {
         for (ray, (hit, occluded)) in rays.iter().zip(&expected) {
             assert_eq!(
-                accel.closest_hit(prims, ray),
+                accel.closest_hit(prims, &PreparedRay::new(*ray)),
                 *hit,
                 "{name}: closest hit differs for {ray:?}"
             );
             assert_eq!(
-                accel.occluded(prims, ray),
+                accel.occluded(prims, &PreparedRay::new(*ray)),
                 *occluded,
                 "{name}: occlusion differs for {ray:?}"
             );
@@ -123,7 +126,7 @@ fn rays_starting_on_a_surface_match_the_list() {
     let mut rng = Rng(77);
     let mut rays = Vec::new();
     for r in random_rays(&mut rng, 3000, 15.0, 8.0) {
-        if let Some(h) = list.closest_hit(prims, &r) {
+        if let Some(h) = list.closest_hit(prims, &PreparedRay::new(r)) {
             let d = rng.vec(1.0).normalize();
             rays.push(Ray::segment(r.at(h.t), d, 1e-4, f32::INFINITY));
             rays.push(Ray::segment(r.at(h.t), d, 0.0, 5.0));

@@ -79,3 +79,20 @@ pub fn parse_errors(scene: &str, text: &str) -> Vec<String> {
         .map(|d| format!("{}:{}: {}", d.loc.line, d.loc.col, d.message))
         .collect()
 }
+
+/// `line:col: severity: message` of every error and warning of parse and build, in
+/// order (notes left out).
+pub fn diagnostics(scene: &str, text: &str, strict: bool) -> Vec<String> {
+    use lucent_io::build::{build, BuildOptions};
+    use lucent_io::cse167::{parse_bytes, ParseOptions};
+    let (desc, mut diags) = parse_bytes(scene, text.as_bytes(), ParseOptions { strict });
+    if !diags.has_errors() {
+        build(&desc, &BuildOptions::default(), &mut diags);
+    }
+    diags
+        .items
+        .iter()
+        .filter(|d| d.severity != lucent_io::diag::Severity::Note)
+        .map(|d| format!("{}:{}: {}: {}", d.loc.line, d.loc.col, d.severity, d.message))
+        .collect()
+}

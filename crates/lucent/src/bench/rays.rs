@@ -14,7 +14,7 @@ use clap::Args;
 use lucent_core::accel::{AccelKind, Accelerator};
 use lucent_core::math::Vec3A;
 use lucent_core::mesh::TriangleMesh;
-use lucent_core::ray::Ray;
+use lucent_core::ray::{PreparedRay, Ray};
 use lucent_io::image::write_file_atomically;
 use lucent_io::obj::load_obj;
 use rayon::prelude::*;
@@ -77,6 +77,7 @@ fn read_rays(path: &std::path::Path) -> Result<Vec<Ray>, String> {
 /// One query: `(t, triangle)` as the answer file stores it.
 #[inline(always)]
 fn answer(accel: &dyn Accelerator<TriangleMesh>, prims: &TriangleMesh, ray: &Ray, occluded: bool) -> (f32, u32) {
+    let ray = &PreparedRay::new(*ray);
     if occluded {
         if accel.occluded(prims, ray) {
             (0.0, 0)

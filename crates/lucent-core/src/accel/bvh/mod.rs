@@ -18,7 +18,7 @@ mod wide;
 
 use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
-use crate::ray::{PreparedRay, Ray};
+use crate::ray::PreparedRay;
 use packet::Packet;
 use wide::WideNode;
 
@@ -113,47 +113,43 @@ fn has_zero_axis(r: &PreparedRay) -> bool {
 }
 
 impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
-    fn closest_hit(&self, prims: &P, ray: &Ray) -> Option<Hit> {
+    fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
         }
-        let r = PreparedRay::new(*ray);
-        let zero = has_zero_axis(&r);
+        let zero = has_zero_axis(r);
         // SAFETY: node and packet references were built by `wide::collapse` for these
         // primitives; the AVX2 path is only taken when the CPU has AVX2 (checked at build).
         unsafe {
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => closest_avx2(self, prims, &r, zero),
+                Isa::Avx2 => closest_avx2(self, prims, r, zero),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => traverse::closest::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 if zero => traverse::closest::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, r),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => traverse::closest::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, &r),
-                _ if zero => traverse::closest::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, &r),
-                _ => traverse::closest::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 => traverse::closest::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, r),
+                _ if zero => traverse::closest::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, r),
+                _ => traverse::closest::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, r),
             }
         }
     }
 
-    fn occluded(&self, prims: &P, ray: &Ray) -> bool {
+    fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let r = PreparedRay::new(*ray);
-        let zero = has_zero_axis(&r);
+        let zero = has_zero_axis(r);
         // SAFETY: as in `closest_hit`.
         unsafe {
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => occluded_avx2(self, prims, &r, zero),
+                Isa::Avx2 => occluded_avx2(self, prims, r, zero),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => {
-                    traverse::occluded::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, &r)
-                }
+                Isa::Sse2 if zero => traverse::occluded::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, r),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => traverse::occluded::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, &r),
-                _ if zero => traverse::occluded::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, &r),
-                _ => traverse::occluded::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, &r),
+                Isa::Sse2 => traverse::occluded::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, r),
+                _ if zero => traverse::occluded::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, r),
+                _ => traverse::occluded::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, r),
             }
         }
     }
