@@ -22,7 +22,7 @@ fn structures(prims: &[Primitive]) -> Vec<Named> {
     #[cfg(target_arch = "x86_64")]
     {
         isas.push(Isa::Sse2);
-        if std::arch::is_x86_feature_detected!("avx2") {
+        if Isa::detect() == Isa::Avx2 {
             isas.push(Isa::Avx2);
         }
     }

@@ -5,9 +5,9 @@
 //! children whose boxes are stored as structure-of-arrays; leaves become packets of four
 //! primitives with precomputed triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): eight box tests per visit with AVX when the CPU has it
-//! (decided once, at build time, with `is_x86_feature_detected!`), two SSE halves when
-//! not; nearest child first, an explicit fixed-size stack, no allocation per ray; the
+//! Traversal ([`traverse`]): eight box tests per visit with AVX2 and FMA when the CPU
+//! has them (decided once, at build time, with `is_x86_feature_detected!`), two SSE
+//! halves when not; nearest child first, an explicit fixed-size stack, no allocation per ray; the
 //! packet test is bit-identical to the scalar watertight triangle test, so the answers
 //! are exactly the brute-force list's.
 
@@ -20,11 +20,13 @@ use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
 use crate::ray::PreparedRay;
 use packet::Packet;
+use traverse::{BoxTest, FmaOffsets, RayBoxes};
 use wide::WideNode;
 
 /// The box-test implementation chosen for this CPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
+    /// AVX2 with FMA (every AVX2 CPU has both).
     Avx2,
     Sse2,
     Scalar,
@@ -34,7 +36,7 @@ impl Isa {
     pub fn detect() -> Isa {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
                 Isa::Avx2
             } else {
                 Isa::Sse2
@@ -64,8 +66,8 @@ impl Bvh {
         let wide = wide::collapse(&tree, prims);
         #[cfg(target_arch = "x86_64")]
         assert!(
-            isa != Isa::Avx2 || std::arch::is_x86_feature_detected!("avx2"),
-            "AVX2 requested on a CPU without it"
+            isa != Isa::Avx2 || Isa::detect() == Isa::Avx2,
+            "AVX2 and FMA requested on a CPU without them"
         );
         Bvh {
             nodes: wide.nodes,
@@ -88,70 +90,106 @@ impl Bvh {
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn closest_avx2<P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, zero: bool) -> Option<Hit> {
-    if zero {
-        traverse::closest::<traverse::Avx, true, P>(&b.nodes, &b.packets, prims, r)
-    } else {
-        traverse::closest::<traverse::Avx, false, P>(&b.nodes, &b.packets, prims, r)
+/// The two queries, so that the choice of box test is written once.
+trait Query<P: PrimitiveSet + ?Sized> {
+    type Answer;
+    const NONE: Self::Answer;
+    /// # Safety
+    /// `T`'s instructions must be available, and `ZERO` set when the ray has a zero
+    /// direction component.
+    unsafe fn run<T: BoxTest, const ZERO: bool>(b: &Bvh, prims: &P, r: &PreparedRay, rb: &T::Ray) -> Self::Answer;
+}
+
+struct Closest;
+struct Occluded;
+
+impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
+    type Answer = Option<Hit>;
+    const NONE: Option<Hit> = None;
+    #[inline(always)]
+    unsafe fn run<T: BoxTest, const ZERO: bool>(b: &Bvh, prims: &P, r: &PreparedRay, rb: &T::Ray) -> Option<Hit> {
+        traverse::closest::<T, ZERO, P>(&b.nodes, &b.packets, prims, r, rb)
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn occluded_avx2<P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, zero: bool) -> bool {
-    if zero {
-        traverse::occluded::<traverse::Avx, true, P>(&b.nodes, &b.packets, prims, r)
-    } else {
-        traverse::occluded::<traverse::Avx, false, P>(&b.nodes, &b.packets, prims, r)
+impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
+    type Answer = bool;
+    const NONE: bool = false;
+    #[inline(always)]
+    unsafe fn run<T: BoxTest, const ZERO: bool>(b: &Bvh, prims: &P, r: &PreparedRay, rb: &T::Ray) -> bool {
+        traverse::occluded::<T, ZERO, P>(&b.nodes, &b.packets, prims, r, rb)
     }
 }
 
-fn has_zero_axis(r: &PreparedRay) -> bool {
-    r.zero_axes.any()
+/// The AVX2 paths, compiled with AVX2 and FMA enabled: the fused box test for rays
+/// that have its constants, the plain one for the others.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+    // The ray's constants are made here, in this function, rather than passed in: handing
+    // them over through memory costs a stalled store-to-load forward per ray.
+    let rb = RayBoxes::new(r);
+    if let Some(offsets) = FmaOffsets::new(r) {
+        Q::run::<traverse::AvxFma, false>(b, prims, r, &traverse::AvxFma::prepare(&rb, &offsets))
+    } else {
+        run_avx2_plain::<Q, P>(b, prims, r, &rb)
+    }
+}
+
+/// The rare rays the fused test cannot take; kept out of line so that the common path
+/// has the registers to itself.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline(never)]
+#[cold]
+unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    rb: &RayBoxes,
+) -> Q::Answer {
+    use traverse::Avx;
+    if r.zero_axes.any() {
+        Q::run::<Avx, true>(b, prims, r, &Avx::prepare(rb))
+    } else {
+        Q::run::<Avx, false>(b, prims, r, &Avx::prepare(rb))
+    }
+}
+
+impl Bvh {
+    #[inline(always)]
+    fn query<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay) -> Q::Answer {
+        if self.nodes.is_empty() {
+            return Q::NONE;
+        }
+        let zero = r.zero_axes.any();
+        // SAFETY: node and packet references were built by `wide::collapse` for these
+        // primitives; the AVX2 path is only taken when the CPU has AVX2 and FMA
+        // (checked at build); SSE2 is part of x86-64.
+        unsafe {
+            match self.isa {
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Sse2 if zero => {
+                    Q::run::<traverse::Sse, true>(self, prims, r, &traverse::Sse::prepare(&RayBoxes::new(r)))
+                }
+                #[cfg(target_arch = "x86_64")]
+                Isa::Sse2 => Q::run::<traverse::Sse, false>(self, prims, r, &traverse::Sse::prepare(&RayBoxes::new(r))),
+                _ if zero => Q::run::<traverse::Scalar, true>(self, prims, r, &RayBoxes::new(r)),
+                _ => Q::run::<traverse::Scalar, false>(self, prims, r, &RayBoxes::new(r)),
+            }
+        }
+    }
 }
 
 impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
     fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
-        if self.nodes.is_empty() {
-            return None;
-        }
-        let zero = has_zero_axis(r);
-        // SAFETY: node and packet references were built by `wide::collapse` for these
-        // primitives; the AVX2 path is only taken when the CPU has AVX2 (checked at build).
-        unsafe {
-            match self.isa {
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => closest_avx2(self, prims, r, zero),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => traverse::closest::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, r),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => traverse::closest::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, r),
-                _ if zero => traverse::closest::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, r),
-                _ => traverse::closest::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, r),
-            }
-        }
+        self.query::<Closest, P>(prims, r)
     }
 
     fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {
-        if self.nodes.is_empty() {
-            return false;
-        }
-        let zero = has_zero_axis(r);
-        // SAFETY: as in `closest_hit`.
-        unsafe {
-            match self.isa {
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => occluded_avx2(self, prims, r, zero),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => traverse::occluded::<traverse::Sse, true, P>(&self.nodes, &self.packets, prims, r),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => traverse::occluded::<traverse::Sse, false, P>(&self.nodes, &self.packets, prims, r),
-                _ if zero => traverse::occluded::<traverse::Scalar, true, P>(&self.nodes, &self.packets, prims, r),
-                _ => traverse::occluded::<traverse::Scalar, false, P>(&self.nodes, &self.packets, prims, r),
-            }
-        }
+        self.query::<Occluded, P>(prims, r)
     }
 
     fn memory_bytes(&self) -> usize {

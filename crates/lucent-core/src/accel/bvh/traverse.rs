@@ -4,10 +4,21 @@
 //! has it — detected at run time — else two SSE halves), then continues with the nearest
 //! child and pushes the others, farthest first, on a fixed stack together with their
 //! entry distance; a popped entry that starts beyond the closest hit found since is
-//! dropped. The box test is the conservative slab test of [`crate::aabb::Aabb::intersect`]
-//! in SIMD form: the far distance is widened by `1 + 2γ(3)`, and axes along which the
-//! ray does not move are decided by where the origin lies (a separate instantiation,
-//! since such rays are rare).
+//! dropped.
+//!
+//! Every box test is conservative: it never rejects a box the exact slab test enters.
+//! * The SSE and scalar tests are the slab test of [`crate::aabb::Aabb::intersect`],
+//!   `(plane - origin) · (1/d)`, with the far distance widened by `1 + 2γ(3)` (folded
+//!   into a per-ray far reciprocal: the same roundings in another order).
+//! * With AVX2 and FMA, each plane costs one fused multiply–add, `plane · (1/d) − o/d`,
+//!   which is shorter on the path from loading a node to choosing the next one. Its
+//!   error is not relative to the result (`o/d` may dwarf the difference), so the ray
+//!   carries two offsets, `o/d ± c` with `c = 2⁻¹⁸·|o/d|`, and a far reciprocal widened
+//!   by `1 + 2⁻¹⁹`: [`FmaOffsets`] states the bound. Rays with an infinite constant, a
+//!   negative `t_min` or an axis they do not move along take the plain AVX test.
+//!
+//! Axes along which the ray does not move are decided by where the origin lies (a
+//! separate instantiation, since such rays are rare).
 
 use std::mem::MaybeUninit;
 
@@ -28,6 +39,8 @@ const FAR_WIDENING: f32 = 1.0 + 2.0 * gamma(3);
 pub struct RayBoxes {
     origin: [f32; 3],
     inv_dir: [f32; 3],
+    /// `inv_dir` times the far widening (left alone where that overflows).
+    inv_far: [f32; 3],
     /// Rows of `WideNode::bounds` holding the planes the ray enters and leaves by.
     near_row: [usize; 3],
     far_row: [usize; 3],
@@ -36,11 +49,19 @@ pub struct RayBoxes {
 }
 
 impl RayBoxes {
+    #[inline(always)]
     pub fn new(r: &PreparedRay) -> RayBoxes {
         let inv = r.inv_dir.to_array();
         RayBoxes {
             origin: r.ray.origin.to_array(),
             inv_dir: inv,
+            inv_far: inv.map(|x| {
+                if (x * FAR_WIDENING).is_finite() {
+                    x * FAR_WIDENING
+                } else {
+                    x
+                }
+            }),
             near_row: [0, 1, 2].map(|a| if inv[a] >= 0.0 { a } else { a + 3 }),
             far_row: [0, 1, 2].map(|a| if inv[a] >= 0.0 { a + 3 } else { a }),
             zero: [r.zero_axes.test(0), r.zero_axes.test(1), r.zero_axes.test(2)],
@@ -49,11 +70,53 @@ impl RayBoxes {
     }
 }
 
+/// The per-ray constants of the fused box test: a plane `b` gives the near distance
+/// `fma(b, inv, −near)` and the far distance `fma(b, inv_far, −far)`.
+///
+/// Why this is conservative (u = 2⁻²⁴, `X = b/d`, `P = o/d`, exact `t = X − P`): the
+/// computed `1/d`, `o·(1/d)`, the offset and the fused result each round once. `near`
+/// is `P + c` with `c ≥ 63u|P|`, which outweighs the ≤ 3u|P| rounding of `P`, so the
+/// near distance is at most `t(1 + 2.01u)` (or negative). For the far distance: when
+/// `X ≥ 0` the widening adds ≥ 30u·X; when `X < 0` then `|X| ≤ |P|` (if `t ≥ 0`) and the
+/// offset's surplus covers the widening's loss; either way the far distance is at least
+/// `t(1 + 23u)`. Hence whenever the exact test enters a box at `t ≥ t_min ≥ 0`, the
+/// computed near ≤ computed far, and near ≤ `search_limit(t_max)`. A test in
+/// `accel::tests` checks this against exact arithmetic on grazing rays.
+#[derive(Clone, Copy)]
+pub struct FmaOffsets {
+    near: [f32; 3],
+    far: [f32; 3],
+    inv_far: [f32; 3],
+}
+
+impl FmaOffsets {
+    const OFFSET: f32 = 1.0 / (1u32 << 18) as f32;
+    const WIDENING: f32 = 1.0 + 1.0 / (1u32 << 19) as f32;
+
+    /// The constants, or `None` for rays that must take the plain test.
+    #[inline(always)]
+    pub fn new(r: &PreparedRay) -> Option<FmaOffsets> {
+        if r.zero_axes.any() || !(r.ray.t_min >= 0.0) {
+            return None;
+        }
+        let (o, inv) = (r.ray.origin.to_array(), r.inv_dir.to_array());
+        let p = [0, 1, 2].map(|a| o[a] * inv[a]);
+        let c = p.map(|p| p.abs() * Self::OFFSET);
+        let f = FmaOffsets {
+            near: [0, 1, 2].map(|a| p[a] + c[a]),
+            far: [0, 1, 2].map(|a| p[a] - c[a]),
+            inv_far: inv.map(|x| x * Self::WIDENING),
+        };
+        let finite = |v: [f32; 3]| v.iter().all(|x| x.is_finite());
+        (finite(inv) && finite(f.near) && finite(f.far) && finite(f.inv_far)).then_some(f)
+    }
+}
+
 /// Which child boxes a ray enters before `t_max`, and where.
 pub trait BoxTest {
-    /// The ray in the form the test wants it (SIMD broadcasts), made once per ray.
+    /// The ray in the form the test wants it (SIMD broadcasts), made once per ray by
+    /// the type's own `prepare`.
     type Ray;
-    unsafe fn prepare(r: &RayBoxes) -> Self::Ray;
     /// `ZERO`: the ray has direction components that are zero.
     unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32;
 }
@@ -62,10 +125,6 @@ pub struct Scalar;
 
 impl BoxTest for Scalar {
     type Ray = RayBoxes;
-    #[inline(always)]
-    unsafe fn prepare(r: &RayBoxes) -> RayBoxes {
-        *r
-    }
     #[inline(always)]
     unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
         let mut mask = 0;
@@ -78,12 +137,11 @@ impl BoxTest for Scalar {
                     inside &= lo <= r.origin[a] && r.origin[a] <= hi;
                 } else {
                     let n = (node.bounds[r.near_row[a]][i] - r.origin[a]) * r.inv_dir[a];
-                    let f = (node.bounds[r.far_row[a]][i] - r.origin[a]) * r.inv_dir[a];
+                    let f = (node.bounds[r.far_row[a]][i] - r.origin[a]) * r.inv_far[a];
                     near = if n > near { n } else { near };
                     far = if f < far { f } else { far };
                 }
             }
-            far *= FAR_WIDENING;
             far = if t_max < far { t_max } else { far };
             *d = near;
             if inside && near <= far {
@@ -95,7 +153,7 @@ impl BoxTest for Scalar {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx, Sse};
+pub use x86::{Avx, AvxFma, Sse};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -104,27 +162,34 @@ mod x86 {
 
     pub struct Sse;
     pub struct Avx;
+    /// AVX with fused multiply–adds ([`FmaOffsets`]); only for rays that have them.
+    pub struct AvxFma;
 
     /// The ray as SIMD broadcasts (`N` is `__m128` or `__m256`).
     #[derive(Clone, Copy)]
     pub struct Broadcast<N> {
         origin: [N; 3],
         inv_dir: [N; 3],
+        inv_far: [N; 3],
         t_min: N,
         rb: RayBoxes,
     }
 
-    impl BoxTest for Sse {
-        type Ray = Broadcast<__m128>;
+    impl Sse {
         #[inline(always)]
-        unsafe fn prepare(r: &RayBoxes) -> Self::Ray {
+        pub unsafe fn prepare(r: &RayBoxes) -> Broadcast<__m128> {
             Broadcast {
                 origin: r.origin.map(|x| _mm_set1_ps(x)),
                 inv_dir: r.inv_dir.map(|x| _mm_set1_ps(x)),
+                inv_far: r.inv_far.map(|x| _mm_set1_ps(x)),
                 t_min: _mm_set1_ps(r.t_min),
                 rb: *r,
             }
         }
+    }
+
+    impl BoxTest for Sse {
+        type Ray = Broadcast<__m128>;
         #[inline(always)]
         unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
             let mut mask = 0;
@@ -140,12 +205,12 @@ mod x86 {
                         inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmple_ps(row(a), o), _mm_cmple_ps(o, row(a + 3))));
                     } else {
                         let n = _mm_mul_ps(_mm_sub_ps(row(rb.near_row[a]), o), r.inv_dir[a]);
-                        let f = _mm_mul_ps(_mm_sub_ps(row(rb.far_row[a]), o), r.inv_dir[a]);
+                        let f = _mm_mul_ps(_mm_sub_ps(row(rb.far_row[a]), o), r.inv_far[a]);
                         near = _mm_max_ps(n, near);
                         far = _mm_min_ps(f, far);
                     }
                 }
-                far = _mm_min_ps(_mm_mul_ps(far, _mm_set1_ps(FAR_WIDENING)), _mm_set1_ps(t_max));
+                far = _mm_min_ps(far, _mm_set1_ps(t_max));
                 _mm_storeu_ps(dist.as_mut_ptr().add(4 * half), near);
                 let hit = _mm_and_ps(_mm_cmple_ps(near, far), inside);
                 mask |= (_mm_movemask_ps(hit) as u32) << (4 * half);
@@ -154,17 +219,21 @@ mod x86 {
         }
     }
 
-    impl BoxTest for Avx {
-        type Ray = Broadcast<__m256>;
+    impl Avx {
         #[inline(always)]
-        unsafe fn prepare(r: &RayBoxes) -> Self::Ray {
+        pub unsafe fn prepare(r: &RayBoxes) -> Broadcast<__m256> {
             Broadcast {
                 origin: r.origin.map(|x| _mm256_set1_ps(x)),
                 inv_dir: r.inv_dir.map(|x| _mm256_set1_ps(x)),
+                inv_far: r.inv_far.map(|x| _mm256_set1_ps(x)),
                 t_min: _mm256_set1_ps(r.t_min),
                 rb: *r,
             }
         }
+    }
+
+    impl BoxTest for Avx {
+        type Ray = Broadcast<__m256>;
         #[inline(always)]
         unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
             let rb = &r.rb;
@@ -184,15 +253,58 @@ mod x86 {
                     );
                 } else {
                     let n = _mm256_mul_ps(_mm256_sub_ps(row(rb.near_row[a]), o), r.inv_dir[a]);
-                    let f = _mm256_mul_ps(_mm256_sub_ps(row(rb.far_row[a]), o), r.inv_dir[a]);
+                    let f = _mm256_mul_ps(_mm256_sub_ps(row(rb.far_row[a]), o), r.inv_far[a]);
                     near = _mm256_max_ps(n, near);
                     far = _mm256_min_ps(f, far);
                 }
             }
-            far = _mm256_min_ps(_mm256_mul_ps(far, _mm256_set1_ps(FAR_WIDENING)), _mm256_set1_ps(t_max));
+            far = _mm256_min_ps(far, _mm256_set1_ps(t_max));
             _mm256_storeu_ps(dist.as_mut_ptr(), near);
             let hit = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far), inside);
             _mm256_movemask_ps(hit) as u32
+        }
+    }
+
+    /// The fused test's ray: reciprocals and offsets as broadcasts.
+    #[derive(Clone, Copy)]
+    pub struct FmaRay {
+        inv_near: [__m256; 3],
+        near: [__m256; 3],
+        inv_far: [__m256; 3],
+        far: [__m256; 3],
+        t_min: __m256,
+        rb: RayBoxes,
+    }
+
+    impl AvxFma {
+        /// `offsets` must come from the same ray.
+        #[inline(always)]
+        pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets) -> FmaRay {
+            FmaRay {
+                inv_near: r.inv_dir.map(|x| _mm256_set1_ps(x)),
+                near: offsets.near.map(|x| _mm256_set1_ps(x)),
+                inv_far: offsets.inv_far.map(|x| _mm256_set1_ps(x)),
+                far: offsets.far.map(|x| _mm256_set1_ps(x)),
+                t_min: _mm256_set1_ps(r.t_min),
+                rb: *r,
+            }
+        }
+    }
+
+    impl BoxTest for AvxFma {
+        type Ray = FmaRay;
+        #[inline(always)]
+        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &FmaRay, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+            let rb = &r.rb;
+            let row = |k: usize| _mm256_load_ps(node.bounds.get_unchecked(k).as_ptr());
+            let mut near = r.t_min;
+            let mut far = _mm256_set1_ps(t_max);
+            for a in 0..3 {
+                near = _mm256_max_ps(_mm256_fmsub_ps(row(rb.near_row[a]), r.inv_near[a], r.near[a]), near);
+                far = _mm256_min_ps(_mm256_fmsub_ps(row(rb.far_row[a]), r.inv_far[a], r.far[a]), far);
+            }
+            _mm256_storeu_ps(dist.as_mut_ptr(), near);
+            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
         }
     }
 }
@@ -244,8 +356,8 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
+    rb: &T::Ray,
 ) -> Option<Hit> {
-    let rb = T::prepare(&RayBoxes::new(r));
     let mut best = None;
     let mut t_max = r.ray.t_max;
     let mut stack = [const { MaybeUninit::<u64>::uninit() }; STACK_SIZE];
@@ -255,7 +367,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     loop {
         if cur & LEAF == 0 {
             let node = node_at(nodes, cur);
-            let mask = T::test::<ZERO>(node, &rb, search_limit(t_max), &mut dist);
+            let mask = T::test::<ZERO>(node, rb, search_limit(t_max), &mut dist);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
@@ -324,8 +436,8 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
+    rb: &T::Ray,
 ) -> bool {
-    let rb = T::prepare(&RayBoxes::new(r));
     let t_max = r.ray.t_max;
     let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK_SIZE];
     let mut sp = 0usize;
@@ -334,7 +446,7 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     loop {
         if cur & LEAF == 0 {
             let node = node_at(nodes, cur);
-            let mut mask = T::test::<ZERO>(node, &rb, search_limit(t_max), &mut dist);
+            let mut mask = T::test::<ZERO>(node, rb, search_limit(t_max), &mut dist);
             if mask != 0 {
                 cur = *node.child.get_unchecked(mask.trailing_zeros() as usize);
                 mask &= mask - 1;
@@ -357,5 +469,123 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
         }
         sp -= 1;
         cur = stack.get_unchecked(sp).assume_init();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::test_scenes::Rng;
+    use crate::math::Vec3A;
+    use crate::ray::Ray;
+
+    /// The slab test in f64 with a true division: within 1e-16 of exact, far inside the
+    /// slack every f32 test is allowed. Returns the entry distance when entered.
+    fn exact_entry(lo: [f32; 3], hi: [f32; 3], r: &Ray, t_max: f32) -> Option<f64> {
+        let (mut near, mut far) = (r.t_min as f64, t_max as f64);
+        for a in 0..3 {
+            let (o, d) = (r.origin[a] as f64, r.dir[a] as f64);
+            if d == 0.0 {
+                if o < lo[a] as f64 || o > hi[a] as f64 {
+                    return None;
+                }
+                continue;
+            }
+            let (t0, t1) = ((lo[a] as f64 - o) / d, (hi[a] as f64 - o) / d);
+            near = near.max(t0.min(t1));
+            far = far.min(t0.max(t1));
+        }
+        (near <= far).then_some(near)
+    }
+
+    /// Eight boxes, and rays from near and far that graze their corners, edges and faces.
+    fn cases(rng: &mut Rng) -> impl Iterator<Item = (WideNode, Ray)> + '_ {
+        (0..20_000).map(move |_| {
+            let mut node = WideNode::EMPTY;
+            let scale = [1e-3, 1.0, 1e3][(rng.next() * 3.0) as usize % 3];
+            let mut boxes = Vec::new();
+            for slot in 0..WIDTH {
+                let c = rng.vec(scale);
+                let e = Vec3A::new(rng.next(), rng.next(), rng.next()) * scale * 0.3;
+                let (lo, hi) = (c - e, c + e);
+                for a in 0..3 {
+                    node.bounds[a][slot] = lo[a];
+                    node.bounds[a + 3][slot] = hi[a];
+                }
+                boxes.push((lo, hi));
+            }
+            // Aim at a corner, an edge or a face point of one box, from near or far away.
+            let (lo, hi) = boxes[(rng.next() * WIDTH as f32) as usize % WIDTH];
+            let pick = |rng: &mut Rng, a: usize| match (rng.next() * 3.0) as u32 {
+                0 => lo[a],
+                1 => hi[a],
+                _ => lo[a] + (hi[a] - lo[a]) * rng.next(),
+            };
+            let target = Vec3A::new(pick(rng, 0), pick(rng, 1), pick(rng, 2));
+            let distance = scale * [0.01, 1.0, 100.0, 1e4][(rng.next() * 4.0) as usize % 4];
+            let origin = target + rng.vec(1.0).normalize_or(Vec3A::X) * distance + rng.vec(scale * 1e3);
+            let mut dir = (target - origin).normalize_or(Vec3A::X);
+            if rng.next() < 0.05 {
+                dir[(rng.next() * 3.0) as usize % 3] = 0.0; // an axis-parallel ray
+            }
+            let t_min = [0.0, 1e-4][(rng.next() * 2.0) as usize % 2];
+            (node, Ray::segment(origin, dir, t_min, f32::INFINITY))
+        })
+    }
+
+    fn check<T: BoxTest>(name: &str, node: &WideNode, r: &Ray, rb: &T::Ray, zero: bool) {
+        for t_max in [f32::INFINITY, 1e3] {
+            let mut dist = [0.0; WIDTH];
+            // SAFETY: callers only pass tests this CPU can run.
+            let mask = unsafe {
+                if zero {
+                    T::test::<true>(node, rb, search_limit(t_max), &mut dist)
+                } else {
+                    T::test::<false>(node, rb, search_limit(t_max), &mut dist)
+                }
+            };
+            for (slot, &entry) in dist.iter().enumerate() {
+                let lo = [0, 1, 2].map(|a| node.bounds[a][slot]);
+                let hi = [0, 1, 2].map(|a| node.bounds[a + 3][slot]);
+                if let Some(near) = exact_entry(lo, hi, r, t_max) {
+                    assert!(mask & 1 << slot != 0, "{name} rejects box {lo:?}..{hi:?} for {r:?}");
+                    // The entry distance must not exceed the true one by more than the
+                    // slack `search_limit` leaves when popping.
+                    assert!(
+                        entry as f64 <= near + near.abs() * 1e-5,
+                        "{name}: entry {entry} beyond {near} for {r:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn box_tests_never_reject_a_box_the_exact_slab_test_enters() {
+        let mut rng = Rng(41);
+        let mut fused = 0;
+        for (node, r) in cases(&mut rng) {
+            let pr = PreparedRay::new(r);
+            let rb = RayBoxes::new(&pr);
+            let zero = pr.zero_axes.any();
+            check::<Scalar>("scalar", &node, &r, &rb, zero);
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: SSE2 is part of x86-64; AVX2 and FMA are checked first.
+            unsafe {
+                check::<Sse>("sse", &node, &r, &Sse::prepare(&rb), zero);
+                if super::super::Isa::detect() == super::super::Isa::Avx2 {
+                    check::<Avx>("avx", &node, &r, &Avx::prepare(&rb), zero);
+                    if let Some(offsets) = FmaOffsets::new(&pr) {
+                        check::<AvxFma>("avx+fma", &node, &r, &AvxFma::prepare(&rb, &offsets), false);
+                        fused += 1;
+                    }
+                }
+            }
+        }
+        if super::super::Isa::detect() == super::super::Isa::Avx2 {
+            assert!(fused > 15_000, "{fused}");
+        } else {
+            eprintln!("note: no AVX2 and FMA here, the fused box test was not checked");
+        }
     }
 }

@@ -31,7 +31,7 @@ pub struct WideNode {
 const _: () = assert!(MAX_LEAF.div_ceil(LANES) <= 1 << (31 - PACKET_SHIFT));
 
 impl WideNode {
-    const EMPTY: WideNode = WideNode {
+    pub const EMPTY: WideNode = WideNode {
         bounds: [
             [f32::INFINITY; WIDTH],
             [f32::INFINITY; WIDTH],
