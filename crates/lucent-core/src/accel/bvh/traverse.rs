@@ -360,6 +360,8 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
 ) -> Option<Hit> {
     let mut best = None;
     let mut t_max = r.ray.t_max;
+    // Boxes are searched a little past the closest hit (ties); kept up to date with it.
+    let mut limit = search_limit(t_max);
     let mut stack = [const { MaybeUninit::<u64>::uninit() }; STACK_SIZE];
     let mut sp = 0usize;
     let mut dist = [0.0f32; WIDTH];
@@ -367,7 +369,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     loop {
         if cur & LEAF == 0 {
             let node = node_at(nodes, cur);
-            let mask = T::test::<ZERO>(node, rb, search_limit(t_max), &mut dist);
+            let mask = T::test::<ZERO>(node, rb, limit, &mut dist);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
@@ -413,6 +415,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
             for p in leaf_packets(cur) {
                 packets.get_unchecked(p).closest(prims, r, &mut t_max, &mut best);
             }
+            limit = search_limit(t_max);
         }
         loop {
             if sp == 0 {
@@ -422,7 +425,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
             let e = stack.get_unchecked(sp).assume_init();
             // Keep an entry whose box starts at (or, by rounding, just beyond) the closest
             // hit: it may hold a tie.
-            if f32::from_bits((e >> 32) as u32) <= search_limit(t_max) {
+            if f32::from_bits((e >> 32) as u32) <= limit {
                 cur = e as u32;
                 break;
             }
