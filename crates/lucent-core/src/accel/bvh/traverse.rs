@@ -33,6 +33,18 @@ use crate::ray::PreparedRay;
 /// Each visit pushes at most `WIDTH - 1` entries and the tree is at most ~100 levels deep.
 const STACK_SIZE: usize = (WIDTH - 1) * 112;
 const FAR_WIDENING: f32 = 1.0 + 2.0 * gamma(3);
+const ROW_BYTES: usize = std::mem::size_of::<[f32; WIDTH]>();
+
+/// Row `offset` (bytes, see [`RayBoxes::near_row`]) of a node's bounds, from lane `lane`.
+#[inline(always)]
+unsafe fn row_ptr(node: &WideNode, offset: usize, lane: usize) -> *const f32 {
+    debug_assert!(offset < 6 * ROW_BYTES && lane < WIDTH);
+    (node as *const WideNode)
+        .cast::<u8>()
+        .add(offset)
+        .cast::<f32>()
+        .add(lane)
+}
 
 /// What the box test needs of a ray, per axis.
 #[derive(Clone, Copy)]
@@ -41,7 +53,8 @@ pub struct RayBoxes {
     inv_dir: [f32; 3],
     /// `inv_dir` times the far widening (left alone where that overflows).
     inv_far: [f32; 3],
-    /// Rows of `WideNode::bounds` holding the planes the ray enters and leaves by.
+    /// Byte offsets in a [`WideNode`] of the rows of `bounds` holding the planes the ray
+    /// enters and leaves by (offsets, not indices: a node visit then adds nothing).
     near_row: [usize; 3],
     far_row: [usize; 3],
     zero: [bool; 3],
@@ -62,8 +75,8 @@ impl RayBoxes {
                     x
                 }
             }),
-            near_row: [0, 1, 2].map(|a| if inv[a] >= 0.0 { a } else { a + 3 }),
-            far_row: [0, 1, 2].map(|a| if inv[a] >= 0.0 { a + 3 } else { a }),
+            near_row: [0, 1, 2].map(|a| ROW_BYTES * if inv[a] >= 0.0 { a } else { a + 3 }),
+            far_row: [0, 1, 2].map(|a| ROW_BYTES * if inv[a] >= 0.0 { a + 3 } else { a }),
             zero: [r.zero_axes.test(0), r.zero_axes.test(1), r.zero_axes.test(2)],
             t_min: r.ray.t_min,
         }
@@ -136,8 +149,8 @@ impl BoxTest for Scalar {
                 if ZERO && r.zero[a] {
                     inside &= lo <= r.origin[a] && r.origin[a] <= hi;
                 } else {
-                    let n = (node.bounds[r.near_row[a]][i] - r.origin[a]) * r.inv_dir[a];
-                    let f = (node.bounds[r.far_row[a]][i] - r.origin[a]) * r.inv_far[a];
+                    let n = (*row_ptr(node, r.near_row[a], i) - r.origin[a]) * r.inv_dir[a];
+                    let f = (*row_ptr(node, r.far_row[a], i) - r.origin[a]) * r.inv_far[a];
                     near = if n > near { n } else { near };
                     far = if f < far { f } else { far };
                 }
@@ -196,6 +209,7 @@ mod x86 {
             let rb = &r.rb;
             for half in 0..2 {
                 let row = |k: usize| _mm_load_ps(node.bounds.get_unchecked(k).as_ptr().add(4 * half));
+                let row_at = |offset: usize| _mm_load_ps(row_ptr(node, offset, 4 * half));
                 let mut near = r.t_min;
                 let mut far = _mm_set1_ps(f32::INFINITY);
                 let mut inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
@@ -204,8 +218,8 @@ mod x86 {
                     if ZERO && rb.zero[a] {
                         inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmple_ps(row(a), o), _mm_cmple_ps(o, row(a + 3))));
                     } else {
-                        let n = _mm_mul_ps(_mm_sub_ps(row(rb.near_row[a]), o), r.inv_dir[a]);
-                        let f = _mm_mul_ps(_mm_sub_ps(row(rb.far_row[a]), o), r.inv_far[a]);
+                        let n = _mm_mul_ps(_mm_sub_ps(row_at(rb.near_row[a]), o), r.inv_dir[a]);
+                        let f = _mm_mul_ps(_mm_sub_ps(row_at(rb.far_row[a]), o), r.inv_far[a]);
                         near = _mm_max_ps(n, near);
                         far = _mm_min_ps(f, far);
                     }
@@ -238,6 +252,7 @@ mod x86 {
         unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
             let rb = &r.rb;
             let row = |k: usize| _mm256_load_ps(node.bounds.get_unchecked(k).as_ptr());
+            let row_at = |offset: usize| _mm256_load_ps(row_ptr(node, offset, 0));
             let mut near = r.t_min;
             let mut far = _mm256_set1_ps(f32::INFINITY);
             let mut inside = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
@@ -252,8 +267,8 @@ mod x86 {
                         ),
                     );
                 } else {
-                    let n = _mm256_mul_ps(_mm256_sub_ps(row(rb.near_row[a]), o), r.inv_dir[a]);
-                    let f = _mm256_mul_ps(_mm256_sub_ps(row(rb.far_row[a]), o), r.inv_far[a]);
+                    let n = _mm256_mul_ps(_mm256_sub_ps(row_at(rb.near_row[a]), o), r.inv_dir[a]);
+                    let f = _mm256_mul_ps(_mm256_sub_ps(row_at(rb.far_row[a]), o), r.inv_far[a]);
                     near = _mm256_max_ps(n, near);
                     far = _mm256_min_ps(f, far);
                 }
@@ -296,12 +311,12 @@ mod x86 {
         #[inline(always)]
         unsafe fn test<const ZERO: bool>(node: &WideNode, r: &FmaRay, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
             let rb = &r.rb;
-            let row = |k: usize| _mm256_load_ps(node.bounds.get_unchecked(k).as_ptr());
+            let row_at = |offset: usize| _mm256_load_ps(row_ptr(node, offset, 0));
             let mut near = r.t_min;
             let mut far = _mm256_set1_ps(t_max);
             for a in 0..3 {
-                near = _mm256_max_ps(_mm256_fmsub_ps(row(rb.near_row[a]), r.inv_near[a], r.near[a]), near);
-                far = _mm256_min_ps(_mm256_fmsub_ps(row(rb.far_row[a]), r.inv_far[a], r.far[a]), far);
+                near = _mm256_max_ps(_mm256_fmsub_ps(row_at(rb.near_row[a]), r.inv_near[a], r.near[a]), near);
+                far = _mm256_min_ps(_mm256_fmsub_ps(row_at(rb.far_row[a]), r.inv_far[a], r.far[a]), far);
             }
             _mm256_storeu_ps(dist.as_mut_ptr(), near);
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
