@@ -182,9 +182,6 @@ impl Packet {
         let scalar = _mm_movemask_ps(any_zero) as u32 | other;
         // Most packets are missed by the edge tests alone: skip the distance then.
         let inside = _mm_movemask_ps(_mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpord_ps(u, u))) as u32 & !scalar;
-        if inside == 0 {
-            return LaneHits::none(scalar);
-        }
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let t_scaled = _mm_add_ps(
             _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, az)), _mm_mul_ps(v, _mm_mul_ps(sz, bz))),
