@@ -358,6 +358,44 @@ fn leaf_packets(reference: u32) -> std::ops::Range<usize> {
     first..first + n
 }
 
+/// Orders stack entries by decreasing distance (so the nearest is popped first): sorting
+/// networks without branches for three and four entries, the common cases, whose
+/// order is unpredictable; insertion sort beyond.
+#[inline(always)]
+fn sort_farthest_first(e: &mut [u64]) {
+    #[inline(always)]
+    fn order(e: &mut [u64], i: usize, j: usize) {
+        let (a, b) = (e[i], e[j]);
+        e[i] = a.max(b);
+        e[j] = a.min(b);
+    }
+    match e.len() {
+        3 => {
+            order(e, 0, 1);
+            order(e, 1, 2);
+            order(e, 0, 1);
+        }
+        4 => {
+            order(e, 0, 1);
+            order(e, 2, 3);
+            order(e, 0, 2);
+            order(e, 1, 3);
+            order(e, 1, 2);
+        }
+        _ => {
+            for i in 1..e.len() {
+                let x = e[i];
+                let mut j = i;
+                while j > 0 && e[j - 1] < x {
+                    e[j] = e[j - 1];
+                    j -= 1;
+                }
+                e[j] = x;
+            }
+        }
+    }
+}
+
 /// A stack entry: the entry distance in the high half (non-negative floats order like
 /// their bits), the node reference in the low half.
 #[inline(always)]
@@ -413,15 +451,8 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
                     stack.get_unchecked_mut(sp).write(e);
                     sp += 1;
                 }
-                for i in base + 1..sp {
-                    let e = stack.get_unchecked(i).assume_init();
-                    let mut j = i;
-                    while j > base && stack.get_unchecked(j - 1).assume_init() < e {
-                        *stack.get_unchecked_mut(j) = *stack.get_unchecked(j - 1);
-                        j -= 1;
-                    }
-                    stack.get_unchecked_mut(j).write(e);
-                }
+                let pushed = std::slice::from_raw_parts_mut(stack.as_mut_ptr().add(base).cast::<u64>(), sp - base);
+                sort_farthest_first(pushed);
                 sp -= 1;
                 cur = stack.get_unchecked(sp).assume_init() as u32;
                 continue;
