@@ -168,20 +168,15 @@ impl Packet {
             _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
             _mm_cmpeq_ps(w, zero),
         );
-        let neg = _mm_or_ps(
-            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
-            _mm_cmplt_ps(w, zero),
-        );
-        let pos = _mm_or_ps(
-            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
-            _mm_cmpgt_ps(w, zero),
-        );
         let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
         // Lanes the scalar code takes: edge functions that rounded to zero, and
         // non-triangles (flagged; their NaN corners never pass the tests below).
         let scalar = _mm_movemask_ps(any_zero) as u32 | other;
-        // Most packets are missed by the edge tests alone: skip the distance then.
-        let inside = _mm_movemask_ps(_mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpord_ps(u, u))) as u32 & !scalar;
+        // With no zero among them, the three edge functions agree in sign exactly when
+        // the sign bits of `u ^ v` and `u ^ w` are clear. (Unused lanes hold NaN, whose
+        // sign is arbitrary; their distance is NaN and fails the range test.)
+        let mixed = _mm_movemask_ps(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w))) as u32;
+        let inside = !mixed & !scalar & 0xF;
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let t_scaled = _mm_add_ps(
             _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, az)), _mm_mul_ps(v, _mm_mul_ps(sz, bz))),
