@@ -500,7 +500,6 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
                 cur = *node.child.get_unchecked(mask.trailing_zeros() as usize);
                 mask &= mask - 1;
                 for i in super::packet::Lanes(mask) {
-                    prefetch(nodes, packets, *node.child.get_unchecked(i));
                     stack.get_unchecked_mut(sp).write(*node.child.get_unchecked(i));
                     sp += 1;
                 }
