@@ -17,7 +17,7 @@ use super::packet::LANES;
 
 const BINS: usize = 16;
 const _: () = assert!(BINS.is_power_of_two(), "bin indices are masked with BINS - 1");
-/// Leaves hold at most this many primitives (two packets).
+/// Leaves hold at most this many primitives (one packet; the collapse may merge two).
 pub const MAX_LEAF: usize = 4;
 /// Cost of one traversal step relative to one packet test (measured on the benchmark
 /// dragons: 2 beats 0.5 and 1, and gives smaller trees; 3 and 4 are no better).

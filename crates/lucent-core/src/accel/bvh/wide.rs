@@ -2,7 +2,8 @@
 //!
 //! Each wide node takes the place of a binary node and adopts its descendants: it starts
 //! with the two children and keeps opening the child with the largest surface area until
-//! it has eight (or only leaves are left). The node stores its children's boxes as
+//! it has eight (or only leaves are left); a child subtree of at most eight primitives
+//! becomes a leaf of two packets instead of a node. The node stores its children's boxes as
 //! structure-of-arrays, so one AVX instruction (or two SSE ones) tests all eight. Leaves
 //! become runs of four-wide packets, laid out in the order traversal meets them.
 
@@ -79,6 +80,25 @@ fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u3
     node.child[slot] = reference;
 }
 
+/// A subtree with at most this many primitives becomes one leaf (of two packets)
+/// rather than a node of its own. Such subtrees are what is left over below a full
+/// node, and a node with two small leaves costs a visit that testing both packets
+/// outright does not (measured: 3–5% faster on the benchmark dragons; 12 is no better).
+const MERGE: u32 = 2 * LANES as u32;
+
+/// The references under binary node `n`, `(start, count)` (a subtree's references are
+/// contiguous), if there are at most [`MERGE`]; stops looking as soon as there are more.
+fn small_subtree(tree: &BinaryTree, n: u32) -> Option<(u32, u32)> {
+    match tree.nodes[n as usize].kind {
+        Kind::Leaf { start, count } => (count <= MERGE).then_some((start, count)),
+        Kind::Interior { left, right } => {
+            let (start, a) = small_subtree(tree, left)?;
+            let (_, b) = small_subtree(tree, right)?;
+            (a + b <= MERGE).then_some((start, a + b))
+        }
+    }
+}
+
 /// Emits the packets of a binary leaf; returns its slot reference.
 fn leaf_slot<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, leaf: &BinaryNode, prims: &P, out: &mut WideTree) -> u32 {
     let Kind::Leaf { start, count } = leaf.kind else {
@@ -130,6 +150,13 @@ fn collapse_node<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, b: u32, prims: &P,
         let child = &tree.nodes[c as usize];
         let reference = match child.kind {
             Kind::Leaf { .. } => leaf_slot(tree, child, prims, out),
+            Kind::Interior { .. } if let Some((start, count)) = small_subtree(tree, c) => {
+                let merged = BinaryNode {
+                    bounds: child.bounds,
+                    kind: Kind::Leaf { start, count },
+                };
+                leaf_slot(tree, &merged, prims, out)
+            }
             Kind::Interior { .. } => {
                 // Interior children are referenced by byte offset: traversal then needs
                 // no multiplication between loading a reference and loading the node.
