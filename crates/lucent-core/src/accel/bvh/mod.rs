@@ -7,8 +7,8 @@
 //!
 //! Traversal ([`traverse`]): eight box tests per visit with AVX2 and FMA when the CPU
 //! has them (decided once, at build time, with `is_x86_feature_detected!`), two SSE
-//! halves when not; nearest child first, an explicit fixed-size stack, no allocation per ray; the
-//! packet test is bit-identical to the scalar watertight triangle test, so the answers
+//! halves when not; nearest child first, an explicit fixed-size stack, no allocation per
+//! ray; the packet test is bit-identical to the scalar watertight triangle test, so the answers
 //! are exactly the brute-force list's.
 
 mod binary;

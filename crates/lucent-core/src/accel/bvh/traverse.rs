@@ -93,8 +93,8 @@ impl RayBoxes {
 /// `X ≥ 0` the widening adds ≥ 30u·X; when `X < 0` then `|X| ≤ |P|` (if `t ≥ 0`) and the
 /// offset's surplus covers the widening's loss; either way the far distance is at least
 /// `t(1 + 23u)`. Hence whenever the exact test enters a box at `t ≥ t_min ≥ 0`, the
-/// computed near ≤ computed far, and near ≤ `search_limit(t_max)`. A test in
-/// `accel::tests` checks this against exact arithmetic on grazing rays.
+/// computed near ≤ computed far, and near ≤ `search_limit(t_max)`. The test at the end
+/// of this file checks every box test against f64 arithmetic on grazing rays.
 #[derive(Clone, Copy)]
 pub struct FmaOffsets {
     near: [f32; 3],
@@ -451,6 +451,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
                     stack.get_unchecked_mut(sp).write(e);
                     sp += 1;
                 }
+                // SAFETY: entries `base..sp` were written just above.
                 let pushed = std::slice::from_raw_parts_mut(stack.as_mut_ptr().add(base).cast::<u64>(), sp - base);
                 sort_farthest_first(pushed);
                 sp -= 1;
@@ -607,6 +608,20 @@ mod tests {
                         "{name}: entry {entry} beyond {near} for {r:?}"
                     );
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn stack_entries_are_sorted_farthest_first_for_every_order() {
+        // Every arrangement of up to six entries, ties included (values 0..n with repeats).
+        for n in 1..=6usize {
+            for code in 0..n.pow(n as u32) {
+                let mut e: Vec<u64> = (0..n).map(|k| (code / n.pow(k as u32) % n) as u64).collect();
+                let mut expected = e.clone();
+                expected.sort_unstable_by(|a, b| b.cmp(a));
+                sort_farthest_first(&mut e);
+                assert_eq!(e, expected);
             }
         }
     }

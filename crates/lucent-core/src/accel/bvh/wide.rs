@@ -3,9 +3,10 @@
 //! Each wide node takes the place of a binary node and adopts its descendants: it starts
 //! with the two children and keeps opening the child with the largest surface area until
 //! it has eight (or only leaves are left); a child subtree of at most eight primitives
-//! becomes a leaf of two packets instead of a node. The node stores its children's boxes as
-//! structure-of-arrays, so one AVX instruction (or two SSE ones) tests all eight. Leaves
-//! become runs of four-wide packets, laid out in the order traversal meets them.
+//! becomes one leaf (of at most two packets) instead of a node. The node stores its
+//! children's boxes as structure-of-arrays, so one AVX instruction (or two SSE ones)
+//! tests all eight. Leaves become runs of four-wide packets, laid out in the order
+//! traversal meets them.
 
 use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
 use super::packet::{Packet, LANES};
@@ -80,11 +81,12 @@ fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u3
     node.child[slot] = reference;
 }
 
-/// A subtree with at most this many primitives becomes one leaf (of two packets)
+/// A subtree with at most this many primitives becomes one leaf (of at most two packets)
 /// rather than a node of its own. Such subtrees are what is left over below a full
 /// node, and a node with two small leaves costs a visit that testing both packets
 /// outright does not (measured: 3–5% faster on the benchmark dragons; 12 is no better).
 const MERGE: u32 = 2 * LANES as u32;
+const _: () = assert!((MERGE as usize).div_ceil(LANES) <= 1 << (31 - PACKET_SHIFT));
 
 /// The references under binary node `n`, `(start, count)` (a subtree's references are
 /// contiguous), if there are at most [`MERGE`]; stops looking as soon as there are more.
