@@ -4,28 +4,47 @@
 //! This crate does no file I/O and knows no scene format: `lucent-io` parses files into
 //! a description and builds a [`scene::Scene`] from it; this crate renders that scene.
 //! The path of one pixel can be read top-down in [`render`].
+//!
+//! The modules stand on floors, and each imports only from its own floor and the floors
+//! below it (`tests/layering.rs` in the `lucent` crate checks every `use`):
+//!
+//! | floor | modules |
+//! |---|---|
+//! | 0 base | [`math`], [`transform`], [`ray`], [`aabb`], [`hit`], [`sampler`] |
+//! | 1 shapes | [`shape`]: intersection routines, texture coordinates, tangents |
+//! | 2 acceleration | [`accel`]: structures over any [`accel::PrimitiveSet`] |
+//! | 3 geometry | [`geometry`]: primitives, meshes, instances, the primitive set |
+//! | 4 tessellation | [`tessellate`]: Bézier, NURBS, subdivision, displacement |
+//! | 5 shading and lights | [`shading`], [`light`], [`camera`] |
+//! | 6 scene | [`scene`] |
+//! | 7 integrators | [`integrator`] |
+//! | 8 render loop and film | [`render`], [`film`] |
 
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod aabb;
-pub mod accel;
-pub mod camera;
-pub mod film;
-pub mod geometry;
 pub mod hit;
-pub mod instance;
-pub mod integrator;
-pub mod light;
-pub mod material;
 pub mod math;
-pub mod mesh;
-pub mod optics;
-pub mod primitive;
 pub mod ray;
-pub mod render;
 pub mod sampler;
-pub mod scene;
-pub mod shape;
-pub mod texture;
 pub mod transform;
+
+pub mod shape;
+
+pub mod accel;
+
+pub mod geometry;
+
+pub mod tessellate;
+
+pub mod camera;
+pub mod light;
+pub mod shading;
+
+pub mod scene;
+
+pub mod integrator;
+
+pub mod film;
+pub mod render;

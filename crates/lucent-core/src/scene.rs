@@ -3,14 +3,14 @@
 
 use crate::accel::AccelKind;
 use crate::camera::Camera;
+use crate::geometry::primitive::Primitive;
 use crate::geometry::Geometry;
 use crate::hit::{Hit, SurfacePoint};
 use crate::light::Light;
-use crate::material::Material;
 use crate::math::Vec3A;
-use crate::primitive::Primitive;
 use crate::ray::Ray;
-use crate::texture::{EnvironmentMap, Texture};
+use crate::shading::material::Material;
+use crate::shading::texture::{EnvironmentMap, Texture};
 
 pub struct Scene {
     pub width: u32,
@@ -103,7 +103,7 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::test_scenes::{analytic_soup, Rng};
+    use crate::geometry::test_scenes::{analytic_soup, Rng};
     use crate::math::DVec3;
     use crate::ray::PreparedRay;
 

@@ -10,17 +10,18 @@ use glam::{DAffine3, DVec3, Vec3};
 use lucent_core::aabb::Aabb;
 use lucent_core::accel::AccelKind;
 use lucent_core::camera::{Camera, Projection};
+use lucent_core::geometry::analytic::{Analytic, AnalyticKind, Sphere};
+use lucent_core::geometry::instance::Instance;
+use lucent_core::geometry::mesh::{MeshShape, TriangleMesh};
+use lucent_core::geometry::primitive::{Primitive, Shape};
 use lucent_core::geometry::Geometry;
-use lucent_core::instance::Instance;
 use lucent_core::integrator::whitted::Whitted;
 use lucent_core::integrator::Integrator;
 use lucent_core::light::{Light, QuadLight};
-use lucent_core::material::Material;
 use lucent_core::math::{Color, Vec3A};
-use lucent_core::mesh::{MeshShape, TriangleMesh};
-use lucent_core::primitive::{Analytic, AnalyticKind, Primitive, Shape, Sphere};
 use lucent_core::scene::{Scene, SceneParts};
-use lucent_core::shape::parametric::grid_mesh;
+use lucent_core::shading::material::Material;
+use lucent_core::tessellate::grid::grid_mesh;
 use lucent_core::transform::Transform;
 
 use crate::desc::*;
@@ -227,7 +228,10 @@ fn build_primitives(
                 let mut mesh = nurbs_mesh(&desc.nurbs[index as usize], t, view);
                 if let Some((texture, scale)) = displacement {
                     let tex = &desc.textures[texture as usize].texture;
-                    match lucent_core::shape::displacement::displace(&mesh, tex, scale) {
+                    match lucent_core::tessellate::displacement::displace(
+                        &mesh,
+                        &lucent_core::shading::texture::Displacement { texture: tex, scale },
+                    ) {
                         Ok(m) => mesh = m,
                         Err(e) => {
                             diags.error(s.loc, format!("nurbs: displacementmap: {e}"));
@@ -369,7 +373,7 @@ fn analytic_kind(kind: &ShapeKind) -> AnalyticKind {
 /// Tessellates a NURBS surface finely enough that no chord strays more than a quarter of
 /// a pixel from the surface where it is nearest to the camera, with normals from the
 /// exact derivatives, in world space.
-fn nurbs_mesh(surface: &lucent_core::shape::nurbs::NurbsSurface, t: &Transform, view: &View) -> TriangleMesh {
+fn nurbs_mesh(surface: &lucent_core::tessellate::nurbs::NurbsSurface, t: &Transform, view: &View) -> TriangleMesh {
     let camera = &view.camera;
     // With positive weights the surface lies in the hull of its control points.
     let corners: Vec<DVec3> = surface.points.iter().map(|p| t.point(p.truncate() / p.w)).collect();

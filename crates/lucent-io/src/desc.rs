@@ -3,7 +3,7 @@
 //! scene. Nothing here is specific to one file format.
 
 use glam::DVec3;
-use lucent_core::material::Material;
+use lucent_core::shading::material::Material;
 use lucent_core::transform::Transform;
 
 use crate::diag::{Loc, SourceMap};
@@ -123,7 +123,7 @@ pub struct ShapeDesc {
 #[derive(Clone, Debug)]
 pub struct TextureDesc {
     pub name: String,
-    pub texture: lucent_core::texture::Texture,
+    pub texture: lucent_core::shading::texture::Texture,
     pub loc: Loc,
 }
 
@@ -202,15 +202,15 @@ pub struct SceneDesc {
     /// Triangle meshes in object space. Per-triangle materials, when present, are
     /// indices into `materials` (from an OBJ file's MTL library); otherwise the mesh
     /// takes the material its shape captured.
-    pub meshes: Vec<lucent_core::mesh::TriangleMesh>,
+    pub meshes: Vec<lucent_core::geometry::mesh::TriangleMesh>,
     pub objects: Vec<ObjectDesc>,
     /// `texture` and `checker`, in the order defined; materials refer to them by index.
     pub textures: Vec<TextureDesc>,
     /// `envmap file [intensity]`.
-    pub environment: Option<Located<lucent_core::texture::EnvironmentMap>>,
+    pub environment: Option<Located<lucent_core::shading::texture::EnvironmentMap>>,
     /// NURBS surfaces (`nurbs` with its `knotsu`, `knotsv` and `cpoint` lines), in object
     /// space; tessellated when the scene is built, when the camera says how fine.
-    pub nurbs: Vec<lucent_core::shape::nurbs::NurbsSurface>,
+    pub nurbs: Vec<lucent_core::tessellate::nurbs::NurbsSurface>,
     /// Transforms captured by shapes and lights (deduplicated while parsing).
     pub transforms: Vec<Transform>,
     /// Materials captured by shapes (deduplicated while parsing).

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use lucent_core::mesh::TriangleMesh;
+use lucent_core::geometry::mesh::TriangleMesh;
 
 /// What a mesh file gives besides its triangles: the materials it names, and what the
 /// loader had to leave out.
@@ -42,7 +42,7 @@ pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
 }
 
 /// Loads the polygons of an OBJ or PLY file, untriangulated (for `subdivmesh`).
-pub fn load_polygons(path: &Path) -> Result<lucent_core::shape::subdivision::ControlMesh, String> {
+pub fn load_polygons(path: &Path) -> Result<lucent_core::tessellate::subdivision::ControlMesh, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("obj") => crate::obj::load_obj_polygons(path),

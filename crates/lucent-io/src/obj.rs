@@ -10,7 +10,7 @@ use std::path::Path;
 
 use crate::mesh_file::{LoadedMesh, MeshMaterial, NO_MATERIAL};
 use glam::{DVec3, Vec2, Vec3};
-use lucent_core::shape::subdivision::ControlMesh;
+use lucent_core::tessellate::subdivision::ControlMesh;
 
 pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
     let options = tobj::LoadOptions {

@@ -10,8 +10,8 @@ use std::io::BufReader;
 use std::path::Path;
 
 use glam::{DVec3, Vec2, Vec3};
-use lucent_core::mesh::TriangleMesh;
-use lucent_core::shape::subdivision::ControlMesh;
+use lucent_core::geometry::mesh::TriangleMesh;
+use lucent_core::tessellate::subdivision::ControlMesh;
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property, PropertyAccess};
 

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use lucent_core::math::Color;
-use lucent_core::texture::{srgb_to_linear, srgb_value_to_linear, Image};
+use lucent_core::shading::texture::{srgb_to_linear, srgb_value_to_linear, Image};
 
 /// The largest image accepted, in texels (a 16k × 16k picture).
 const MAX_TEXELS: u64 = 1 << 28;

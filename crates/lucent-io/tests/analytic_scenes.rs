@@ -331,7 +331,7 @@ fn a_rotated_cylinder_in_front_of_an_infinite_plane() {
 
 /// The `nurbs` lines of the textbook rational quadratic sphere of radius `r`.
 fn nurbs_sphere_text(r: f64) -> String {
-    let s = lucent_core::shape::nurbs::sphere(r);
+    let s = lucent_core::tessellate::nurbs::sphere(r);
     let mut text = String::from("nurbs 2 2 9 5\n");
     let knots = |k: &[f64]| k.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ");
     text += &format!("knotsu {}\nknotsv {}\n", knots(&s.knots_u), knots(&s.knots_v));

@@ -135,8 +135,8 @@ fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Aabb> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_scenes::Rng;
     use super::*;
+    use crate::accel::test_sets::Rng;
 
     #[test]
     fn clipping_and_the_separating_axis_test_agree() {

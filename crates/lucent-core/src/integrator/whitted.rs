@@ -26,16 +26,14 @@
 //!   surface count as black.
 
 use super::Integrator;
-use crate::hit::{Hit, SurfacePoint, BACKGROUND};
+use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::light::Light;
-use crate::material::BumpMap;
 use crate::math::Color;
-use crate::math::Vec3A;
-use crate::optics::{fresnel_dielectric, phong_lobe, reflect, refract};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
-use crate::texture::{luminance, Texture};
+use crate::shading::bump;
+use crate::shading::optics::{fresnel_dielectric, phong_lobe, reflect, refract};
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
 /// 8-bit step: they are not traced.
@@ -76,7 +74,8 @@ impl Whitted {
             return Some((seen, sp));
         }
         if let Some(bump) = m.bump_map {
-            sp.normal = bumped_normal(scene, &hit, ray, &sp, bump);
+            let (dpdu, dpdv) = scene.tangents(&hit, ray);
+            sp.normal = bump::bumped_normal(&scene.textures[bump.texture as usize], bump, &sp, dpdu, dpdv);
         }
         let diffuse = match m.diffuse_map {
             Some(t) => m.diffuse * scene.textures[t as usize].eval(sp.uv, sp.point),
@@ -195,33 +194,5 @@ impl Integrator for Whitted {
         let mut t = Tracing { scene, sampler, rays };
         self.trace(&mut t, *ray, 0, Color::ONE, &mut total);
         total
-    }
-}
-
-/// The shading normal of a bump-mapped surface (Blinn 1978): the surface displaced along
-/// its normal by `strength × luminance` of the texture, differentiated along `∂p/∂u` and
-/// `∂p/∂v` by central differences half a texel wide.
-fn bumped_normal(scene: &Scene, hit: &Hit, ray: &Ray, sp: &SurfacePoint, bump: BumpMap) -> Vec3A {
-    let (dpdu, dpdv) = scene.tangents(hit, ray);
-    let tex = &scene.textures[bump.texture as usize];
-    let (du, dv) = match tex {
-        Texture::Image(img) => (0.5 / img.width as f32, 0.5 / img.height as f32),
-        Texture::Checker { .. } => (1e-3, 1e-3),
-    };
-    let height = |duv: glam::Vec2, dp: Vec3A| bump.strength * luminance(tex.eval(sp.uv + duv, sp.point + dp));
-    let u = glam::Vec2::new(du, 0.0);
-    let v = glam::Vec2::new(0.0, dv);
-    let hu = (height(u, dpdu * du) - height(-u, -dpdu * du)) / (2.0 * du);
-    let hv = (height(v, dpdv * dv) - height(-v, -dpdv * dv)) / (2.0 * dv);
-    let n = sp.normal;
-    let base = dpdu.cross(dpdv);
-    let bumped = (dpdu + n * hu).cross(dpdv + n * hv);
-    // The tangents' cross product may point to either side; the normal keeps its own.
-    let bumped = if base.dot(n) < 0.0 { -bumped } else { bumped };
-    let out = bumped.normalize();
-    if out.is_finite() {
-        out
-    } else {
-        n
     }
 }

@@ -3,13 +3,13 @@
 //! relative to the scene's folder, so that their errors point at the command.
 
 use glam::Vec3;
-use lucent_core::mesh::TriangleMesh;
-use lucent_core::shape::parametric::grid_mesh;
-use lucent_core::shape::subdivision::{self, Scheme};
+use lucent_core::geometry::mesh::TriangleMesh;
+use lucent_core::tessellate::grid::grid_mesh;
+use lucent_core::tessellate::subdivision::{self, Scheme};
 
 use std::path::Path;
 
-use lucent_core::texture::Texture;
+use lucent_core::shading::texture::Texture;
 
 use super::{io_reason, Command, Parser};
 use crate::desc::{MaterialDesc, ShapeKind, TextureDesc};
@@ -217,7 +217,7 @@ impl Parser {
         let d = divisions as usize;
         let mut mesh = TriangleMesh::default();
         for patch in &patches.patches {
-            let grid: Vec<(Vec3, Vec3)> = lucent_core::shape::bezier::tessellate(patch, divisions)
+            let grid: Vec<(Vec3, Vec3)> = lucent_core::tessellate::bezier::tessellate(patch, divisions)
                 .into_iter()
                 .map(|(p, n)| (p.as_vec3(), n.as_vec3()))
                 .collect();
@@ -231,7 +231,10 @@ impl Parser {
     fn add_mesh(&mut self, c: &Command, mut mesh: TriangleMesh) {
         if let Some((texture, scale)) = self.displacement {
             let tex = &self.desc.textures[texture as usize].texture;
-            match lucent_core::shape::displacement::displace(&mesh, tex, scale) {
+            match lucent_core::tessellate::displacement::displace(
+                &mesh,
+                &lucent_core::shading::texture::Displacement { texture: tex, scale },
+            ) {
                 Ok(m) => mesh = m,
                 Err(e) => {
                     self.err_cmd(c, format!("{}: displacementmap: {e}", c.name.text));

@@ -183,7 +183,7 @@ struct PendingNurbs {
     line: u32,
     transform: u32,
     material: u32,
-    surface: lucent_core::shape::nurbs::NurbsSurface,
+    surface: lucent_core::tessellate::nurbs::NurbsSurface,
 }
 
 struct Parser {
@@ -897,7 +897,7 @@ impl Parser {
             line: c.line,
             transform,
             material,
-            surface: lucent_core::shape::nurbs::NurbsSurface {
+            surface: lucent_core::tessellate::nurbs::NurbsSurface {
                 degree_u: du as usize,
                 degree_v: dv as usize,
                 count_u: nu as usize,
@@ -910,7 +910,7 @@ impl Parser {
     }
 
     /// What the pending surface needs next.
-    fn nurbs_expects(s: &lucent_core::shape::nurbs::NurbsSurface) -> String {
+    fn nurbs_expects(s: &lucent_core::tessellate::nurbs::NurbsSurface) -> String {
         if s.knots_u.is_empty() {
             "knotsu".into()
         } else if s.knots_v.is_empty() {

@@ -3,7 +3,7 @@
 
 use super::{Command, Parser};
 use crate::desc::Located;
-use lucent_core::material::Glossy;
+use lucent_core::shading::material::Glossy;
 
 /// More glossy rays than this per hit would only burn time.
 const MAX_GLOSSY_SAMPLES: i64 = 4096;

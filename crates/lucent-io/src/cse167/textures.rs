@@ -6,8 +6,8 @@
 use super::{Command, Parser};
 use crate::desc::{Located, TextureDesc};
 use crate::texture_file::load_image;
-use lucent_core::material::BumpMap;
-use lucent_core::texture::{EnvironmentMap, Texture};
+use lucent_core::shading::material::BumpMap;
+use lucent_core::shading::texture::{EnvironmentMap, Texture};
 
 impl Parser {
     /// `texture name file` and `checker name r1 g1 b1 r2 g2 b2 scale`.

@@ -12,8 +12,8 @@ use std::time::Instant;
 
 use clap::Args;
 use lucent_core::accel::{AccelKind, Accelerator};
+use lucent_core::geometry::mesh::TriangleMesh;
 use lucent_core::math::Vec3A;
-use lucent_core::mesh::TriangleMesh;
 use lucent_core::ray::{PreparedRay, Ray};
 use lucent_io::image::write_file_atomically;
 use lucent_io::obj::load_obj;

@@ -200,23 +200,23 @@ impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::test_scenes::soup;
+    use crate::accel::test_sets::Triangles;
 
     #[test]
     fn every_primitive_is_in_exactly_one_leaf_and_nodes_are_wide() {
-        let prims = soup(11, 5000);
-        let bvh = Bvh::build(prims.as_slice());
+        let prims = Triangles::random(11, 5000);
+        let bvh = Bvh::build(&prims);
         let mut seen = bvh.leaf_prims();
         seen.sort_unstable();
-        assert!(seen.iter().copied().eq(0..prims.len() as u32));
+        assert!(seen.iter().copied().eq(0..prims.0.len() as u32));
         // A binary tree with leaves of up to four would need about n/2 nodes; eight-wide
         // nodes need several times fewer.
         assert!(
-            bvh.node_count() > 50 && bvh.node_count() < prims.len() / 6,
+            bvh.node_count() > 50 && bvh.node_count() < prims.0.len() / 6,
             "{}",
             bvh.node_count()
         );
         // Packets are mostly full.
-        assert!(bvh.packets.len() * packet::LANES < prims.len() * 3 / 2);
+        assert!(bvh.packets.len() * packet::LANES < prims.0.len() * 3 / 2);
     }
 }

@@ -527,7 +527,7 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::accel::test_scenes::Rng;
+    use crate::accel::test_sets::Rng;
     use crate::math::Vec3A;
     use crate::ray::Ray;
 

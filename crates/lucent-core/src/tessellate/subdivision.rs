@@ -18,7 +18,7 @@
 use std::collections::HashMap;
 use std::f64::consts::PI;
 
-use crate::mesh::TriangleMesh;
+use crate::geometry::mesh::TriangleMesh;
 use glam::DVec3;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,10 +1,10 @@
 //! A set of primitives with its acceleration structure: the whole scene, or one object
-//! that `instance` places many times ([`crate::instance`]).
+//! that `instance` places many times ([`super::instance`]).
 
+use super::primitive::{Primitive, Shape};
 use crate::accel::{AccelKind, Accelerator};
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::Vec3A;
-use crate::primitive::{Primitive, Shape};
 use crate::ray::{PreparedRay, Ray};
 
 pub struct Geometry {

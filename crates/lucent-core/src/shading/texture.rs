@@ -6,6 +6,7 @@
 //! texture of the world-space hit point.
 
 use crate::math::{Color, Vec3A};
+use crate::tessellate::displacement::{Detail, HeightField};
 use glam::Vec2;
 
 /// An image in linear RGB, row 0 at the top.
@@ -73,6 +74,26 @@ impl Texture {
                     *b
                 }
             }
+        }
+    }
+}
+
+/// `displacementmap name scale`: the texture's luminance times `scale` as a height field.
+/// An image's finest detail is a texel; a checker's, a quarter of a cell.
+pub struct Displacement<'a> {
+    pub texture: &'a Texture,
+    pub scale: f32,
+}
+
+impl HeightField for Displacement<'_> {
+    fn height(&self, uv: Vec2, p: Vec3A) -> f32 {
+        self.scale * luminance(self.texture.eval(uv, p))
+    }
+
+    fn detail(&self) -> Detail {
+        match self.texture {
+            Texture::Image(img) => Detail::Texel(1.0 / img.width.max(img.height) as f32),
+            Texture::Checker { scale, .. } => Detail::Solid(0.25 * scale),
         }
     }
 }

@@ -5,10 +5,30 @@
 
 use std::collections::HashMap;
 
+use crate::geometry::mesh::TriangleMesh;
 use crate::math::Vec3A;
-use crate::mesh::TriangleMesh;
-use crate::texture::{luminance, Texture};
 use glam::{Vec2, Vec3};
+
+/// What displaces a surface: a height at each vertex, and the size of the finest detail
+/// it has (which decides how far the surface is refined first). Textures provide it on
+/// the shading floor (`crate::shading::texture::Displacement`).
+pub trait HeightField {
+    /// The height at a vertex with texture coordinates `uv` (zero when the mesh has
+    /// none) and object-space position `p`.
+    fn height(&self, uv: Vec2, p: Vec3A) -> f32;
+    fn detail(&self) -> Detail;
+}
+
+/// The size of a height field's finest detail.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Detail {
+    /// A texel, this wide in texture coordinates: looked up at the vertices' texture
+    /// coordinates, which the mesh must have.
+    Texel(f32),
+    /// A feature this large in the mesh's own space, looked up at the vertices'
+    /// positions.
+    Solid(f32),
+}
 
 /// Refinement stops at this many triangles, texel size or not.
 pub const MAX_DISPLACED_TRIANGLES: usize = 1 << 21;
@@ -67,31 +87,29 @@ pub fn vertex_normals(mesh: &TriangleMesh) -> Vec<Vec3> {
     normals.iter().map(|n| n.normalize_or_zero()).collect()
 }
 
-/// How many times to split so that triangle edges span about one texel of `texture`
-/// in texture space (and no more than [`MAX_DISPLACED_TRIANGLES`] result). A checker is
-/// refined until edges are a quarter of a cell in the mesh's own space.
-fn levels_for(mesh: &TriangleMesh, texture: &Texture) -> u32 {
-    let edge = match texture {
-        Texture::Image(img) if !mesh.uvs.is_empty() => {
-            let texel = 1.0 / img.width.max(img.height) as f32;
-            let span = mesh
-                .indices
-                .iter()
-                .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+/// How many times to split so that triangle edges span about one unit of detail (a
+/// texel in texture space, or a solid feature in the mesh's own space), with no more
+/// than [`MAX_DISPLACED_TRIANGLES`] as a result.
+fn levels_for(mesh: &TriangleMesh, detail: Detail) -> u32 {
+    let edges = || {
+        mesh.indices
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+    };
+    let edge = match detail {
+        Detail::Texel(texel) if !mesh.uvs.is_empty() => {
+            let span = edges()
                 .map(|(a, b)| (mesh.uvs[a as usize] - mesh.uvs[b as usize]).abs().max_element())
                 .fold(0.0f32, f32::max);
             span / texel
         }
-        Texture::Checker { scale, .. } => {
-            let span = mesh
-                .indices
-                .iter()
-                .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        Detail::Solid(size) => {
+            let span = edges()
                 .map(|(a, b)| (mesh.positions[a as usize] - mesh.positions[b as usize]).length())
                 .fold(0.0f32, f32::max);
-            span / (0.25 * scale)
+            span / size
         }
-        Texture::Image(_) => 1.0,
+        Detail::Texel(_) => 1.0,
     };
     let mut levels = 0;
     let mut triangles = mesh.indices.len();
@@ -104,25 +122,24 @@ fn levels_for(mesh: &TriangleMesh, texture: &Texture) -> u32 {
     levels
 }
 
-/// The mesh refined and displaced by `scale × luminance(texture)` along its normals
-/// (computed from the faces where the mesh has none), with normals recomputed from the
-/// displaced faces. Image textures are looked up at the vertices' texture coordinates,
-/// which the mesh must have; a checker at the vertices' positions.
-pub fn displace(mesh: &TriangleMesh, texture: &Texture, scale: f32) -> Result<TriangleMesh, String> {
-    if matches!(texture, Texture::Image(_)) && mesh.uvs.is_empty() {
+/// The mesh refined and displaced by the height field along its normals (computed from
+/// the faces where the mesh has none), with normals recomputed from the displaced faces.
+pub fn displace(mesh: &TriangleMesh, field: &impl HeightField) -> Result<TriangleMesh, String> {
+    let detail = field.detail();
+    if matches!(detail, Detail::Texel(_)) && mesh.uvs.is_empty() {
         return Err("the surface has no texture coordinates to look the image up at".into());
     }
     let mut m = mesh.clone();
     if m.normals.is_empty() {
         m.normals = vertex_normals(&m);
     }
-    for _ in 0..levels_for(mesh, texture) {
+    for _ in 0..levels_for(mesh, detail) {
         m = split(&m);
     }
     for i in 0..m.positions.len() {
         let p = m.positions[i];
         let uv = m.uvs.get(i).copied().unwrap_or(Vec2::ZERO);
-        let h = scale * luminance(texture.eval(uv, Vec3A::from(p)));
+        let h = field.height(uv, Vec3A::from(p));
         m.positions[i] = p + m.normals[i] * h;
     }
     m.normals = vertex_normals(&m);
@@ -132,25 +149,53 @@ pub fn displace(mesh: &TriangleMesh, texture: &Texture, scale: f32) -> Result<Tr
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Color;
-    use crate::texture::Image;
+
+    /// Height `scale × u` sampled like a texture `texels` wide.
+    struct Ramp {
+        texels: u32,
+        scale: f32,
+    }
+
+    impl HeightField for Ramp {
+        fn height(&self, uv: Vec2, _: Vec3A) -> f32 {
+            // The texel centres' values, interpolated (and wrapped) as bilinear filtering does.
+            let n = self.texels as f32;
+            let x = (uv.x - uv.x.floor()) * n - 0.5;
+            let (i, f) = (x.floor(), x - x.floor());
+            let value = |k: f32| (k.rem_euclid(n) + 0.5) / n;
+            self.scale * (value(i) * (1.0 - f) + value(i + 1.0) * f)
+        }
+        fn detail(&self) -> Detail {
+            Detail::Texel(1.0 / self.texels as f32)
+        }
+    }
+
+    /// Alternating heights 0 and `scale` in cubes of side `cell`.
+    struct Blocks {
+        cell: f32,
+    }
+
+    impl HeightField for Blocks {
+        fn height(&self, _: Vec2, p: Vec3A) -> f32 {
+            let c = (p / self.cell).floor();
+            (c.x + c.y + c.z).rem_euclid(2.0) * 0.1
+        }
+        fn detail(&self) -> Detail {
+            Detail::Solid(0.25 * self.cell)
+        }
+    }
 
     fn square(n: usize) -> TriangleMesh {
         let points: Vec<(Vec3, Vec3)> = (0..=n)
             .flat_map(|i| (0..=n).map(move |j| (Vec3::new(j as f32 / n as f32, i as f32 / n as f32, 0.0), Vec3::Z)))
             .collect();
-        crate::shape::parametric::grid_mesh(&points, n, n)
+        crate::tessellate::grid::grid_mesh(&points, n, n)
     }
 
     #[test]
     fn a_ramp_lifts_the_square_into_a_slope_and_keeps_it_watertight() {
-        // Luminance = u across 16 texels: the square becomes z ≈ 0.5·u.
-        let img = Image {
-            width: 16,
-            height: 1,
-            texels: (0..16).map(|x| Color::splat((x as f32 + 0.5) / 16.0)).collect(),
-        };
-        let out = displace(&square(1), &Texture::Image(img), 0.5).unwrap();
+        // Height 0.5·u across 16 texels: the square becomes z ≈ 0.5·u.
+        let out = displace(&square(1), &Ramp { texels: 16, scale: 0.5 }).unwrap();
         assert!(
             out.indices.len() >= 2 * 16 * 16,
             "refined to about a texel: {}",
@@ -184,20 +229,13 @@ mod tests {
     }
 
     #[test]
-    fn images_need_texture_coordinates() {
+    fn texel_detail_needs_texture_coordinates_and_solid_detail_refines_by_size() {
         let mut m = square(2);
         m.uvs.clear();
-        let img = Image {
-            width: 1,
-            height: 1,
-            texels: vec![Color::ONE],
-        };
-        assert!(displace(&m, &Texture::Image(img), 1.0).is_err());
-        let checker = Texture::Checker {
-            a: Color::ONE,
-            b: Color::ZERO,
-            scale: 0.5,
-        };
-        assert!(displace(&m, &checker, 0.1).is_ok());
+        assert!(displace(&m, &Ramp { texels: 1, scale: 1.0 }).is_err());
+        let out = displace(&m, &Blocks { cell: 0.5 }).unwrap();
+        // Refined until edges are below a quarter of a cell: the diagonals (0.71) of the
+        // 2 × 2 quads are halved three times, so the 8 triangles become 8 · 4³.
+        assert_eq!(out.indices.len(), 8 * 64);
     }
 }

@@ -124,7 +124,7 @@ impl NurbsSurface {
             let (_, su, sv) = self.evaluate(u, v);
             (su, sv)
         };
-        super::parametric::normal(derivatives, (u, v), ((u0 + u1) / 2.0, (v0 + v1) / 2.0))
+        super::grid::normal(derivatives, (u, v), ((u0 + u1) / 2.0, (v0 + v1) / 2.0))
     }
 
     /// Segments along u and v so that no chord strays more than `tolerance` from the

@@ -138,7 +138,7 @@ impl TriangleMesh {
             return (p[1] - p[0], p[2] - p[0]);
         }
         let uv = self.indices[hit.prim as usize].map(|i| self.uvs[i as usize]);
-        crate::shape::parametric::triangle_tangents(p, uv)
+        crate::shape::tangents::triangle_tangents(p, uv)
     }
 
     /// Shading data at `hit` (whose `prim` is the triangle) on the ray `origin + t·dir`.

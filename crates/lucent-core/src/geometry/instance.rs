@@ -5,8 +5,8 @@
 
 use std::sync::Arc;
 
+use super::Geometry;
 use crate::aabb::Aabb;
-use crate::geometry::Geometry;
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Affine3A, Mat3A, Vec3A};
 use crate::ray::{PreparedRay, Ray};

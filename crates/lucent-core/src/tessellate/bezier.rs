@@ -47,7 +47,7 @@ pub fn normal(p: &[DVec3; 16], u: f64, v: f64) -> Option<DVec3> {
         let (_, su, sv) = evaluate(p, u, v);
         (su, sv)
     };
-    super::parametric::normal(derivatives, (u, v), (0.5, 0.5))
+    super::grid::normal(derivatives, (u, v), (0.5, 0.5))
 }
 
 /// `(divisions + 1)²` points and normals on a regular `(u, v)` grid, row by row in `v`.

@@ -1,12 +1,13 @@
-//! Property tests every structure must pass: the same closest hit and the same
-//! occlusion answer as the brute-force list, on random soups and degenerate input.
+//! Property tests every structure must pass over the primitives a scene holds: the same
+//! closest hit and the same occlusion answer as the brute-force list, on random soups of
+//! every kind of primitive and on degenerate input.
 
-use super::bvh::{Bvh, Isa};
-use super::list::PrimitiveList;
+use super::primitive::{Primitive, Shape};
 use super::test_scenes::{analytic_soup, coplanar_grid, soup, Rng};
-use super::{AccelKind, Accelerator};
+use crate::accel::bvh::{Bvh, Isa};
+use crate::accel::list::PrimitiveList;
+use crate::accel::{AccelKind, Accelerator};
 use crate::math::Vec3A;
-use crate::primitive::{Primitive, Shape};
 use crate::ray::{PreparedRay, Ray};
 
 type Named = (String, Box<dyn Accelerator<[Primitive]>>);
