@@ -12,6 +12,7 @@
 //! are exactly the brute-force list's.
 
 mod binary;
+mod lanes;
 mod packet;
 mod traverse;
 mod wide;
@@ -20,7 +21,7 @@ use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
 use crate::ray::PreparedRay;
 use packet::Packet;
-use traverse::{BoxTest, FmaOffsets, RayBoxes};
+use traverse::{BoxTest, FmaOffsets, RayBoxes, Slab};
 use wide::WideNode;
 
 /// The box-test implementation chosen for this CPU.
@@ -128,9 +129,11 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
 unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
     // The ray's constants are made here, in this function, rather than passed in: handing
     // them over through memory costs a stalled store-to-load forward per ray.
+    use lanes::Avx;
+    use traverse::Fused;
     let rb = RayBoxes::new(r);
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<traverse::AvxFma, false>(b, prims, r, &traverse::AvxFma::prepare(&rb, &offsets))
+        Q::run::<Fused<Avx>, false>(b, prims, r, &Fused::prepare(&rb, &offsets))
     } else {
         run_avx2_plain::<Q, P>(b, prims, r, &rb)
     }
@@ -148,11 +151,11 @@ unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     r: &PreparedRay,
     rb: &RayBoxes,
 ) -> Q::Answer {
-    use traverse::Avx;
+    use lanes::Avx;
     if r.zero_axes.any() {
-        Q::run::<Avx, true>(b, prims, r, &Avx::prepare(rb))
+        Q::run::<Slab<Avx>, true>(b, prims, r, &Slab::prepare(rb))
     } else {
-        Q::run::<Avx, false>(b, prims, r, &Avx::prepare(rb))
+        Q::run::<Slab<Avx>, false>(b, prims, r, &Slab::prepare(rb))
     }
 }
 
@@ -172,12 +175,12 @@ impl Bvh {
                 Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
                 #[cfg(target_arch = "x86_64")]
                 Isa::Sse2 if zero => {
-                    Q::run::<traverse::Sse, true>(self, prims, r, &traverse::Sse::prepare(&RayBoxes::new(r)))
+                    Q::run::<Slab<lanes::Sse>, true>(self, prims, r, &Slab::prepare(&RayBoxes::new(r)))
                 }
                 #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => Q::run::<traverse::Sse, false>(self, prims, r, &traverse::Sse::prepare(&RayBoxes::new(r))),
-                _ if zero => Q::run::<traverse::Scalar, true>(self, prims, r, &RayBoxes::new(r)),
-                _ => Q::run::<traverse::Scalar, false>(self, prims, r, &RayBoxes::new(r)),
+                Isa::Sse2 => Q::run::<Slab<lanes::Sse>, false>(self, prims, r, &Slab::prepare(&RayBoxes::new(r))),
+                _ if zero => Q::run::<Slab<f32>, true>(self, prims, r, &Slab::prepare(&RayBoxes::new(r))),
+                _ => Q::run::<Slab<f32>, false>(self, prims, r, &Slab::prepare(&RayBoxes::new(r))),
             }
         }
     }

@@ -1,7 +1,8 @@
 //! Walking the wide BVH: closest-hit and any-hit queries.
 //!
 //! Each node visit tests the ray against all eight child boxes at once (AVX when the CPU
-//! has it — detected at run time — else two SSE halves), then continues with the nearest
+//! has it — detected at run time — else two SSE halves; the tests are written once over
+//! the lanes of [`super::lanes`]), then continues with the nearest
 //! child and pushes the others, farthest first, on a fixed stack together with their
 //! entry distance; a popped entry that starts beyond the closest hit found since is
 //! dropped.
@@ -20,8 +21,10 @@
 //! Axes along which the ray does not move are decided by where the origin lies (a
 //! separate instantiation, since such rays are rare).
 
+use std::marker::PhantomData;
 use std::mem::MaybeUninit;
 
+use super::lanes::{FusedLanes, Lanes};
 use super::packet::Packet;
 use super::wide::{WideNode, FIRST_MASK, LEAF, PACKET_SHIFT, WIDTH};
 use crate::accel::search_limit;
@@ -127,200 +130,120 @@ impl FmaOffsets {
 
 /// Which child boxes a ray enters before `t_max`, and where.
 pub trait BoxTest {
-    /// The ray in the form the test wants it (SIMD broadcasts), made once per ray by
-    /// the type's own `prepare`.
+    /// The ray in the form the test wants it (lanes of broadcast constants), made once
+    /// per ray by the type's own `prepare`.
     type Ray;
     /// `ZERO`: the ray has direction components that are zero.
     unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32;
 }
 
-pub struct Scalar;
+/// The slab test over lanes `L`: `(plane − origin) · (1/d)` per plane, the far distance
+/// with the widened reciprocal; axes the ray does not move along are decided by where
+/// the origin lies. The node's eight boxes take `WIDTH / L::N` steps.
+pub struct Slab<L>(PhantomData<L>);
 
-impl BoxTest for Scalar {
-    type Ray = RayBoxes;
+/// The ray as lanes of broadcast constants (see [`Slab`]).
+#[derive(Clone, Copy)]
+pub struct SlabRay<L> {
+    origin: [L; 3],
+    inv_dir: [L; 3],
+    inv_far: [L; 3],
+    t_min: L,
+    rb: RayBoxes,
+}
+
+impl<L: Lanes> Slab<L> {
     #[inline(always)]
-    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &RayBoxes, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+    pub unsafe fn prepare(r: &RayBoxes) -> SlabRay<L> {
+        SlabRay {
+            origin: r.origin.map(|x| L::splat(x)),
+            inv_dir: r.inv_dir.map(|x| L::splat(x)),
+            inv_far: r.inv_far.map(|x| L::splat(x)),
+            t_min: L::splat(r.t_min),
+            rb: *r,
+        }
+    }
+}
+
+impl<L: Lanes> BoxTest for Slab<L> {
+    type Ray = SlabRay<L>;
+    #[inline(always)]
+    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &SlabRay<L>, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        let rb = &r.rb;
         let mut mask = 0;
-        for (i, d) in dist.iter_mut().enumerate() {
-            let (mut near, mut far) = (r.t_min, f32::INFINITY);
-            let mut inside = true;
+        for first in (0..WIDTH).step_by(L::N) {
+            let row = |offset: usize| L::load(row_ptr(node, offset, first));
+            let mut near = r.t_min;
+            let mut far = L::splat(f32::INFINITY);
+            let mut inside = L::all();
             for a in 0..3 {
-                let (lo, hi) = (node.bounds[a][i], node.bounds[a + 3][i]);
-                if ZERO && r.zero[a] {
-                    inside &= lo <= r.origin[a] && r.origin[a] <= hi;
+                let o = r.origin[a];
+                if ZERO && rb.zero[a] {
+                    let (lo, hi) = (row(a * ROW_BYTES), row((a + 3) * ROW_BYTES));
+                    inside = L::and(inside, L::and(lo.le(o), o.le(hi)));
                 } else {
-                    let n = (*row_ptr(node, r.near_row[a], i) - r.origin[a]) * r.inv_dir[a];
-                    let f = (*row_ptr(node, r.far_row[a], i) - r.origin[a]) * r.inv_far[a];
-                    near = if n > near { n } else { near };
-                    far = if f < far { f } else { far };
+                    let n = row(rb.near_row[a]).sub(o).mul(r.inv_dir[a]);
+                    let f = row(rb.far_row[a]).sub(o).mul(r.inv_far[a]);
+                    near = n.max(near);
+                    far = f.min(far);
                 }
             }
-            far = if t_max < far { t_max } else { far };
-            *d = near;
-            if inside && near <= far {
-                mask |= 1 << i;
-            }
+            far = far.min(L::splat(t_max));
+            near.store(dist.as_mut_ptr().add(first));
+            mask |= L::bits(L::and(near.le(far), inside)) << first;
         }
         mask
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-pub use x86::{Avx, AvxFma, Sse};
+/// The fused slab test over lanes `L` ([`FmaOffsets`]): one multiply–subtract per
+/// plane, `plane · (1/d) − o/d`; only for rays that have the offsets (no zero axes).
+pub struct Fused<L>(PhantomData<L>);
 
-#[cfg(target_arch = "x86_64")]
-mod x86 {
-    use super::*;
-    use std::arch::x86_64::*;
+/// The fused test's ray: reciprocals and offsets as lanes of broadcasts.
+#[derive(Clone, Copy)]
+pub struct FusedRay<L> {
+    inv_near: [L; 3],
+    near: [L; 3],
+    inv_far: [L; 3],
+    far: [L; 3],
+    t_min: L,
+    rb: RayBoxes,
+}
 
-    pub struct Sse;
-    pub struct Avx;
-    /// AVX with fused multiply–adds ([`FmaOffsets`]); only for rays that have them.
-    pub struct AvxFma;
-
-    /// The ray as SIMD broadcasts (`N` is `__m128` or `__m256`).
-    #[derive(Clone, Copy)]
-    pub struct Broadcast<N> {
-        origin: [N; 3],
-        inv_dir: [N; 3],
-        inv_far: [N; 3],
-        t_min: N,
-        rb: RayBoxes,
-    }
-
-    impl Sse {
-        #[inline(always)]
-        pub unsafe fn prepare(r: &RayBoxes) -> Broadcast<__m128> {
-            Broadcast {
-                origin: r.origin.map(|x| _mm_set1_ps(x)),
-                inv_dir: r.inv_dir.map(|x| _mm_set1_ps(x)),
-                inv_far: r.inv_far.map(|x| _mm_set1_ps(x)),
-                t_min: _mm_set1_ps(r.t_min),
-                rb: *r,
-            }
+impl<L: FusedLanes> Fused<L> {
+    /// `offsets` must come from the same ray.
+    #[inline(always)]
+    pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets) -> FusedRay<L> {
+        FusedRay {
+            inv_near: r.inv_dir.map(|x| L::splat(x)),
+            near: offsets.near.map(|x| L::splat(x)),
+            inv_far: offsets.inv_far.map(|x| L::splat(x)),
+            far: offsets.far.map(|x| L::splat(x)),
+            t_min: L::splat(r.t_min),
+            rb: *r,
         }
     }
+}
 
-    impl BoxTest for Sse {
-        type Ray = Broadcast<__m128>;
-        #[inline(always)]
-        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            let mut mask = 0;
-            let rb = &r.rb;
-            for half in 0..2 {
-                let row = |k: usize| _mm_load_ps(node.bounds.get_unchecked(k).as_ptr().add(4 * half));
-                let row_at = |offset: usize| _mm_load_ps(row_ptr(node, offset, 4 * half));
-                let mut near = r.t_min;
-                let mut far = _mm_set1_ps(f32::INFINITY);
-                let mut inside = _mm_castsi128_ps(_mm_set1_epi32(-1));
-                for a in 0..3 {
-                    let o = r.origin[a];
-                    if ZERO && rb.zero[a] {
-                        inside = _mm_and_ps(inside, _mm_and_ps(_mm_cmple_ps(row(a), o), _mm_cmple_ps(o, row(a + 3))));
-                    } else {
-                        let n = _mm_mul_ps(_mm_sub_ps(row_at(rb.near_row[a]), o), r.inv_dir[a]);
-                        let f = _mm_mul_ps(_mm_sub_ps(row_at(rb.far_row[a]), o), r.inv_far[a]);
-                        near = _mm_max_ps(n, near);
-                        far = _mm_min_ps(f, far);
-                    }
-                }
-                far = _mm_min_ps(far, _mm_set1_ps(t_max));
-                _mm_storeu_ps(dist.as_mut_ptr().add(4 * half), near);
-                let hit = _mm_and_ps(_mm_cmple_ps(near, far), inside);
-                mask |= (_mm_movemask_ps(hit) as u32) << (4 * half);
-            }
-            mask
-        }
-    }
-
-    impl Avx {
-        #[inline(always)]
-        pub unsafe fn prepare(r: &RayBoxes) -> Broadcast<__m256> {
-            Broadcast {
-                origin: r.origin.map(|x| _mm256_set1_ps(x)),
-                inv_dir: r.inv_dir.map(|x| _mm256_set1_ps(x)),
-                inv_far: r.inv_far.map(|x| _mm256_set1_ps(x)),
-                t_min: _mm256_set1_ps(r.t_min),
-                rb: *r,
-            }
-        }
-    }
-
-    impl BoxTest for Avx {
-        type Ray = Broadcast<__m256>;
-        #[inline(always)]
-        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            let rb = &r.rb;
-            let row = |k: usize| _mm256_load_ps(node.bounds.get_unchecked(k).as_ptr());
-            let row_at = |offset: usize| _mm256_load_ps(row_ptr(node, offset, 0));
+impl<L: FusedLanes> BoxTest for Fused<L> {
+    type Ray = FusedRay<L>;
+    #[inline(always)]
+    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &FusedRay<L>, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        let rb = &r.rb;
+        let mut mask = 0;
+        for first in (0..WIDTH).step_by(L::N) {
+            let row = |offset: usize| L::load(row_ptr(node, offset, first));
             let mut near = r.t_min;
-            let mut far = _mm256_set1_ps(f32::INFINITY);
-            let mut inside = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+            let mut far = L::splat(t_max);
             for a in 0..3 {
-                let o = r.origin[a];
-                if ZERO && rb.zero[a] {
-                    inside = _mm256_and_ps(
-                        inside,
-                        _mm256_and_ps(
-                            _mm256_cmp_ps::<_CMP_LE_OQ>(row(a), o),
-                            _mm256_cmp_ps::<_CMP_LE_OQ>(o, row(a + 3)),
-                        ),
-                    );
-                } else {
-                    let n = _mm256_mul_ps(_mm256_sub_ps(row_at(rb.near_row[a]), o), r.inv_dir[a]);
-                    let f = _mm256_mul_ps(_mm256_sub_ps(row_at(rb.far_row[a]), o), r.inv_far[a]);
-                    near = _mm256_max_ps(n, near);
-                    far = _mm256_min_ps(f, far);
-                }
+                near = row(rb.near_row[a]).mul_sub(r.inv_near[a], r.near[a]).max(near);
+                far = row(rb.far_row[a]).mul_sub(r.inv_far[a], r.far[a]).min(far);
             }
-            far = _mm256_min_ps(far, _mm256_set1_ps(t_max));
-            _mm256_storeu_ps(dist.as_mut_ptr(), near);
-            let hit = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far), inside);
-            _mm256_movemask_ps(hit) as u32
+            near.store(dist.as_mut_ptr().add(first));
+            mask |= L::bits(near.le(far)) << first;
         }
-    }
-
-    /// The fused test's ray: reciprocals and offsets as broadcasts.
-    #[derive(Clone, Copy)]
-    pub struct FmaRay {
-        inv_near: [__m256; 3],
-        near: [__m256; 3],
-        inv_far: [__m256; 3],
-        far: [__m256; 3],
-        t_min: __m256,
-        rb: RayBoxes,
-    }
-
-    impl AvxFma {
-        /// `offsets` must come from the same ray.
-        #[inline(always)]
-        pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets) -> FmaRay {
-            FmaRay {
-                inv_near: r.inv_dir.map(|x| _mm256_set1_ps(x)),
-                near: offsets.near.map(|x| _mm256_set1_ps(x)),
-                inv_far: offsets.inv_far.map(|x| _mm256_set1_ps(x)),
-                far: offsets.far.map(|x| _mm256_set1_ps(x)),
-                t_min: _mm256_set1_ps(r.t_min),
-                rb: *r,
-            }
-        }
-    }
-
-    impl BoxTest for AvxFma {
-        type Ray = FmaRay;
-        #[inline(always)]
-        unsafe fn test<const ZERO: bool>(node: &WideNode, r: &FmaRay, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
-            let rb = &r.rb;
-            let row_at = |offset: usize| _mm256_load_ps(row_ptr(node, offset, 0));
-            let mut near = r.t_min;
-            let mut far = _mm256_set1_ps(t_max);
-            for a in 0..3 {
-                near = _mm256_max_ps(_mm256_fmsub_ps(row_at(rb.near_row[a]), r.inv_near[a], r.near[a]), near);
-                far = _mm256_min_ps(_mm256_fmsub_ps(row_at(rb.far_row[a]), r.inv_far[a], r.far[a]), far);
-            }
-            _mm256_storeu_ps(dist.as_mut_ptr(), near);
-            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32
-        }
+        mask
     }
 }
 
@@ -634,16 +557,20 @@ mod tests {
             let pr = PreparedRay::new(r);
             let rb = RayBoxes::new(&pr);
             let zero = pr.zero_axes.any();
-            check::<Scalar>("scalar", &node, &r, &rb, zero);
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: SSE2 is part of x86-64; AVX2 and FMA are checked first.
+            // SAFETY: plain f32 runs anywhere; SSE2 is part of x86-64; AVX2 and FMA are
+            // checked first.
             unsafe {
-                check::<Sse>("sse", &node, &r, &Sse::prepare(&rb), zero);
-                if super::super::Isa::detect() == super::super::Isa::Avx2 {
-                    check::<Avx>("avx", &node, &r, &Avx::prepare(&rb), zero);
-                    if let Some(offsets) = FmaOffsets::new(&pr) {
-                        check::<AvxFma>("avx+fma", &node, &r, &AvxFma::prepare(&rb, &offsets), false);
-                        fused += 1;
+                check::<Slab<f32>>("scalar", &node, &r, &Slab::prepare(&rb), zero);
+                #[cfg(target_arch = "x86_64")]
+                {
+                    use super::super::lanes::{Avx, Sse};
+                    check::<Slab<Sse>>("sse", &node, &r, &Slab::prepare(&rb), zero);
+                    if super::super::Isa::detect() == super::super::Isa::Avx2 {
+                        check::<Slab<Avx>>("avx", &node, &r, &Slab::prepare(&rb), zero);
+                        if let Some(offsets) = FmaOffsets::new(&pr) {
+                            check::<Fused<Avx>>("avx+fma", &node, &r, &Fused::prepare(&rb, &offsets), false);
+                            fused += 1;
+                        }
                     }
                 }
             }

@@ -1,0 +1,219 @@
+//! A few `f32` lanes side by side, and the handful of operations the box test needs,
+//! written once per instruction set: plain `f32` (one lane), SSE (four) and AVX (eight,
+//! with fused multiply–add). The box tests of [`super::traverse`] are written once over
+//! this trait, so a wider instruction set costs one implementation here, not another
+//! copy of the test.
+//!
+//! Every operation is the single instruction it names (`max`/`min` return the second
+//! operand when either is NaN, as `maxps`/`minps` do); the implementations are
+//! `#[inline(always)]` and only take effect inside functions compiled for their
+//! instruction set.
+
+/// A vector of `N` lanes.
+pub trait Lanes: Copy {
+    const N: usize;
+    /// The result of a comparison, one flag per lane.
+    type Mask: Copy;
+    unsafe fn splat(x: f32) -> Self;
+    /// Loads `N` floats from `p`, aligned to `N · 4` bytes.
+    unsafe fn load(p: *const f32) -> Self;
+    /// Stores `N` floats at `p` (no alignment needed).
+    unsafe fn store(self, p: *mut f32);
+    unsafe fn sub(self, other: Self) -> Self;
+    unsafe fn mul(self, other: Self) -> Self;
+    /// `self > other ? self : other`.
+    unsafe fn max(self, other: Self) -> Self;
+    /// `self < other ? self : other`.
+    unsafe fn min(self, other: Self) -> Self;
+    unsafe fn le(self, other: Self) -> Self::Mask;
+    unsafe fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    unsafe fn all() -> Self::Mask;
+    /// Bit `i` set where lane `i` is set.
+    unsafe fn bits(m: Self::Mask) -> u32;
+}
+
+/// Lanes with a fused multiply–subtract.
+pub trait FusedLanes: Lanes {
+    /// `self · b − c` with one rounding.
+    unsafe fn mul_sub(self, b: Self, c: Self) -> Self;
+}
+
+/// One lane: the portable fallback.
+impl Lanes for f32 {
+    const N: usize = 1;
+    type Mask = bool;
+    #[inline(always)]
+    unsafe fn splat(x: f32) -> f32 {
+        x
+    }
+    #[inline(always)]
+    unsafe fn load(p: *const f32) -> f32 {
+        *p
+    }
+    #[inline(always)]
+    unsafe fn store(self, p: *mut f32) {
+        *p = self
+    }
+    #[inline(always)]
+    unsafe fn sub(self, other: f32) -> f32 {
+        self - other
+    }
+    #[inline(always)]
+    unsafe fn mul(self, other: f32) -> f32 {
+        self * other
+    }
+    #[inline(always)]
+    unsafe fn max(self, other: f32) -> f32 {
+        if self > other {
+            self
+        } else {
+            other
+        }
+    }
+    #[inline(always)]
+    unsafe fn min(self, other: f32) -> f32 {
+        if self < other {
+            self
+        } else {
+            other
+        }
+    }
+    #[inline(always)]
+    unsafe fn le(self, other: f32) -> bool {
+        self <= other
+    }
+    #[inline(always)]
+    unsafe fn and(a: bool, b: bool) -> bool {
+        a & b
+    }
+    #[inline(always)]
+    unsafe fn all() -> bool {
+        true
+    }
+    #[inline(always)]
+    unsafe fn bits(m: bool) -> u32 {
+        m as u32
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx, Sse};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::{FusedLanes, Lanes};
+    use std::arch::x86_64::*;
+
+    /// Four lanes (SSE, part of every x86-64).
+    #[derive(Clone, Copy)]
+    pub struct Sse(__m128);
+
+    impl Lanes for Sse {
+        const N: usize = 4;
+        type Mask = __m128;
+        #[inline(always)]
+        unsafe fn splat(x: f32) -> Sse {
+            Sse(_mm_set1_ps(x))
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f32) -> Sse {
+            Sse(_mm_load_ps(p))
+        }
+        #[inline(always)]
+        unsafe fn store(self, p: *mut f32) {
+            _mm_storeu_ps(p, self.0)
+        }
+        #[inline(always)]
+        unsafe fn sub(self, other: Sse) -> Sse {
+            Sse(_mm_sub_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn mul(self, other: Sse) -> Sse {
+            Sse(_mm_mul_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn max(self, other: Sse) -> Sse {
+            Sse(_mm_max_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn min(self, other: Sse) -> Sse {
+            Sse(_mm_min_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn le(self, other: Sse) -> __m128 {
+            _mm_cmple_ps(self.0, other.0)
+        }
+        #[inline(always)]
+        unsafe fn and(a: __m128, b: __m128) -> __m128 {
+            _mm_and_ps(a, b)
+        }
+        #[inline(always)]
+        unsafe fn all() -> __m128 {
+            _mm_castsi128_ps(_mm_set1_epi32(-1))
+        }
+        #[inline(always)]
+        unsafe fn bits(m: __m128) -> u32 {
+            _mm_movemask_ps(m) as u32
+        }
+    }
+
+    /// Eight lanes (AVX; the fused form needs FMA, which every AVX2 CPU has).
+    #[derive(Clone, Copy)]
+    pub struct Avx(__m256);
+
+    impl Lanes for Avx {
+        const N: usize = 8;
+        type Mask = __m256;
+        #[inline(always)]
+        unsafe fn splat(x: f32) -> Avx {
+            Avx(_mm256_set1_ps(x))
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f32) -> Avx {
+            Avx(_mm256_load_ps(p))
+        }
+        #[inline(always)]
+        unsafe fn store(self, p: *mut f32) {
+            _mm256_storeu_ps(p, self.0)
+        }
+        #[inline(always)]
+        unsafe fn sub(self, other: Avx) -> Avx {
+            Avx(_mm256_sub_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn mul(self, other: Avx) -> Avx {
+            Avx(_mm256_mul_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn max(self, other: Avx) -> Avx {
+            Avx(_mm256_max_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn min(self, other: Avx) -> Avx {
+            Avx(_mm256_min_ps(self.0, other.0))
+        }
+        #[inline(always)]
+        unsafe fn le(self, other: Avx) -> __m256 {
+            _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, other.0)
+        }
+        #[inline(always)]
+        unsafe fn and(a: __m256, b: __m256) -> __m256 {
+            _mm256_and_ps(a, b)
+        }
+        #[inline(always)]
+        unsafe fn all() -> __m256 {
+            _mm256_castsi256_ps(_mm256_set1_epi32(-1))
+        }
+        #[inline(always)]
+        unsafe fn bits(m: __m256) -> u32 {
+            _mm256_movemask_ps(m) as u32
+        }
+    }
+
+    impl FusedLanes for Avx {
+        #[inline(always)]
+        unsafe fn mul_sub(self, b: Avx, c: Avx) -> Avx {
+            Avx(_mm256_fmsub_ps(self.0, b.0, c.0))
+        }
+    }
+}
