@@ -5,6 +5,10 @@
 //! distance `focus` (depth of field) for the perspective camera. The frame is
 //! `w = normalize(E − C)`, `u = normalize(U × w)`, `v = w × u`; row 0 of the image is the
 //! top.
+//!
+//! The camera does not know the image's size: a [`Resolution`] comes with every ray
+//! request, from the render job, so a crop or a different size is a setting of the
+//! render, not of the scene.
 
 use crate::math::{DVec3, Vec3A};
 use crate::ray::Ray;
@@ -15,6 +19,20 @@ pub enum Projection {
     Perspective { fovy: f64 },
     /// World-space height of the view.
     Orthographic { height: f64 },
+}
+
+/// The size of the whole image in pixels: the camera's view is divided into this many
+/// square pixels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Resolution {
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Resolution {
+    pub fn pixels(self) -> u64 {
+        self.width as u64 * self.height as u64
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -29,8 +47,6 @@ pub struct Camera {
     orthographic: bool,
     /// Thin lens: radius and focus distance.
     lens: Option<(f64, f64)>,
-    width: f64,
-    height: f64,
 }
 
 /// Why a camera cannot be built.
@@ -45,32 +61,11 @@ pub enum CameraError {
 
 impl Camera {
     /// A pinhole camera.
-    pub fn look_at(
-        eye: DVec3,
-        center: DVec3,
-        up: DVec3,
-        fovy_degrees: f64,
-        width: u32,
-        height: u32,
-    ) -> Result<Camera, CameraError> {
-        Camera::new(
-            eye,
-            center,
-            up,
-            Projection::Perspective { fovy: fovy_degrees },
-            width,
-            height,
-        )
+    pub fn look_at(eye: DVec3, center: DVec3, up: DVec3, fovy_degrees: f64) -> Result<Camera, CameraError> {
+        Camera::new(eye, center, up, Projection::Perspective { fovy: fovy_degrees })
     }
 
-    pub fn new(
-        eye: DVec3,
-        center: DVec3,
-        up: DVec3,
-        projection: Projection,
-        width: u32,
-        height: u32,
-    ) -> Result<Camera, CameraError> {
+    pub fn new(eye: DVec3, center: DVec3, up: DVec3, projection: Projection) -> Result<Camera, CameraError> {
         let (half_height, orthographic) = match projection {
             Projection::Perspective { fovy } => {
                 if !(fovy > 0.0 && fovy < 180.0) {
@@ -104,8 +99,6 @@ impl Camera {
             half_height,
             orthographic,
             lens: None,
-            width: width as f64,
-            height: height as f64,
         })
     }
 
@@ -122,12 +115,14 @@ impl Camera {
         self.lens.is_some()
     }
 
-    /// The ray through the image point (`x`, `y`) in pixel units: column `j` and row `i`
-    /// have their centre at `(j + 0.5, i + 0.5)`. `lens` is a point of the unit square
-    /// that picks the point of the lens the ray leaves from (ignored without a lens).
-    pub fn ray(&self, x: f64, y: f64, lens: (f32, f32)) -> Ray {
-        let a = self.half_height * (self.width / self.height) * (2.0 * x / self.width - 1.0);
-        let b = self.half_height * (1.0 - 2.0 * y / self.height);
+    /// The ray through the point (`x`, `y`), in pixel units, of an image of `resolution`:
+    /// column `j` and row `i` have their centre at `(j + 0.5, i + 0.5)`. `lens` is a point
+    /// of the unit square that picks the point of the lens the ray leaves from (ignored
+    /// without a lens).
+    pub fn ray(&self, resolution: Resolution, x: f64, y: f64, lens: (f32, f32)) -> Ray {
+        let (width, height) = (resolution.width as f64, resolution.height as f64);
+        let a = self.half_height * (width / height) * (2.0 * x / width - 1.0);
+        let b = self.half_height * (1.0 - 2.0 * y / height);
         let (origin, dir) = if self.orthographic {
             (self.eye + self.u * a + self.v * b, -self.w)
         } else {
@@ -171,13 +166,17 @@ mod tests {
 
     #[test]
     fn centre_ray_looks_at_the_target_and_corners_span_the_fov() {
-        let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 90.0, 200, 100).unwrap();
-        let r = c.ray(100.0, 50.0, (0.5, 0.5));
+        let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 90.0).unwrap();
+        let res = Resolution {
+            width: 200,
+            height: 100,
+        };
+        let r = c.ray(res, 100.0, 50.0, (0.5, 0.5));
         assert!((r.dir - Vec3A::new(0.0, 0.0, -1.0)).length() < 1e-7);
         // Top edge at 45°; right edge at atan(2) because tan(fovx/2) = tan(fovy/2)·W/H.
-        let top = c.ray(100.0, 0.0, (0.5, 0.5)).dir;
+        let top = c.ray(res, 100.0, 0.0, (0.5, 0.5)).dir;
         assert!((top.y / -top.z - 1.0).abs() < 1e-6);
-        let right = c.ray(200.0, 50.0, (0.5, 0.5)).dir;
+        let right = c.ray(res, 200.0, 50.0, (0.5, 0.5)).dir;
         assert!((right.x / -right.z - 2.0).abs() < 1e-6);
     }
 
@@ -188,20 +187,23 @@ mod tests {
             DVec3::new(0.0, -1.0, 0.0),
             DVec3::new(0.0, 1.0, 1.0),
             45.0,
-            64,
-            48,
         )
         .unwrap();
-        let up = c.ray(32.0, 0.0, (0.5, 0.5)).dir - c.ray(32.0, 48.0, (0.5, 0.5)).dir;
+        let res = Resolution { width: 64, height: 48 };
+        let up = c.ray(res, 32.0, 0.0, (0.5, 0.5)).dir - c.ray(res, 32.0, 48.0, (0.5, 0.5)).dir;
         assert!(up.y > 0.0 && up.z > 0.0);
     }
 
     #[test]
     fn orthographic_rays_are_parallel_and_span_the_height() {
         let ortho = Projection::Orthographic { height: 4.0 };
-        let c = Camera::new(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, ortho, 200, 100).unwrap();
-        let top = c.ray(100.0, 0.0, (0.5, 0.5));
-        let corner = c.ray(200.0, 100.0, (0.5, 0.5));
+        let c = Camera::new(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, ortho).unwrap();
+        let res = Resolution {
+            width: 200,
+            height: 100,
+        };
+        let top = c.ray(res, 100.0, 0.0, (0.5, 0.5));
+        let corner = c.ray(res, 200.0, 100.0, (0.5, 0.5));
         assert_eq!(top.dir, Vec3A::new(0.0, 0.0, -1.0));
         assert_eq!(corner.dir, top.dir);
         assert!((top.origin - Vec3A::new(0.0, 2.0, 5.0)).length() < 1e-6);
@@ -210,14 +212,15 @@ mod tests {
 
     #[test]
     fn lens_rays_meet_on_the_plane_of_focus() {
-        let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 60.0, 64, 48)
+        let c = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 60.0)
             .unwrap()
             .with_lens(0.5, 4.0);
-        let pinhole = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 60.0, 64, 48).unwrap();
-        let p = pinhole.ray(10.0, 7.0, (0.5, 0.5));
+        let pinhole = Camera::look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y, 60.0).unwrap();
+        let res = Resolution { width: 64, height: 48 };
+        let p = pinhole.ray(res, 10.0, 7.0, (0.5, 0.5));
         let focus = p.at(4.0 / -p.dir.z);
         for lens in [(0.0, 0.0), (0.9, 0.2), (0.3, 0.99)] {
-            let r = c.ray(10.0, 7.0, lens);
+            let r = c.ray(res, 10.0, 7.0, lens);
             assert!((r.origin.z - 5.0).abs() < 1e-6 && r.origin.truncate().length() <= 0.5 + 1e-6);
             let at = r.at((focus.z - r.origin.z) / r.dir.z);
             assert!((at - focus).length() < 1e-4, "{at} vs {focus}");
@@ -233,7 +236,7 @@ mod tests {
 
     #[test]
     fn degenerate_cameras_are_refused() {
-        let bad = |e: DVec3, c: DVec3, u: DVec3, f: f64| Camera::look_at(e, c, u, f, 10, 10).unwrap_err();
+        let bad = |e: DVec3, c: DVec3, u: DVec3, f: f64| Camera::look_at(e, c, u, f).unwrap_err();
         assert_eq!(bad(DVec3::Z, DVec3::ZERO, DVec3::Y, 0.0), CameraError::FovOutOfRange);
         assert_eq!(bad(DVec3::Z, DVec3::ZERO, DVec3::Y, 180.0), CameraError::FovOutOfRange);
         assert_eq!(bad(DVec3::Z, DVec3::Z, DVec3::Y, 45.0), CameraError::EyeAtTarget);

@@ -76,6 +76,9 @@ pub struct SurfacePoint {
     /// Texture coordinates (conventions in [`crate::shape::texcoord`]).
     pub uv: Vec2,
     pub material: u32,
+    /// The light this point emits as, if it belongs to an emitting primitive (index into
+    /// the scene's lights).
+    pub light: Option<u32>,
 }
 
 /// Pixel value of a ray that hits nothing.

@@ -84,6 +84,16 @@ pub struct Incidence {
 }
 
 impl Light {
+    /// The radiance a ray travelling along `dir` sees where it meets the light's surface
+    /// with normal `normal`: a quad light's radiance on its emitting side, black from
+    /// behind (and nothing for lights that have no surface).
+    pub fn radiance_seen(&self, dir: Vec3A, normal: Vec3A) -> Color {
+        match self {
+            Light::Quad(q) if dir.dot(normal) > 0.0 => q.radiance,
+            _ => Color::ZERO,
+        }
+    }
+
     /// What a point or directional light delivers to `x` (area lights are sampled
     /// point by point: [`QuadLight::incidence`]).
     pub fn incidence(&self, x: Vec3A) -> Incidence {

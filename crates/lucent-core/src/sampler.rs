@@ -2,9 +2,9 @@
 //! (`spp`), lens positions (`lens`), points on area lights (`quadLight`) and glossy
 //! directions (`glossy`).
 //!
-//! Every number is a hash of (pixel, sample index, dimension): a pixel's samples do not
-//! depend on which thread renders it or in what order, so the picture is the same bytes
-//! for any thread count.
+//! Every number is a hash of (seed, pixel, sample index, dimension): a pixel's samples do
+//! not depend on which thread renders it or in what order, so the picture is the same
+//! bytes for any thread count. The seed belongs to the render job; seed 0 is the default.
 
 /// The random numbers of one sample of one pixel, drawn in a fixed order.
 #[derive(Clone, Debug)]
@@ -22,10 +22,11 @@ fn mix(mut z: u64) -> u64 {
 }
 
 impl Sampler {
-    pub fn new(x: u32, y: u32, sample: u32) -> Sampler {
+    pub fn new(seed: u64, x: u32, y: u32, sample: u32) -> Sampler {
         let pixel = (y as u64) << 32 | x as u64;
         Sampler {
-            key: mix(mix(pixel) ^ (sample as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)),
+            // `mix(0) = 0`: seed 0 leaves the key of the unseeded sequence.
+            key: mix(mix(pixel) ^ (sample as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)) ^ mix(seed),
             dimension: 0,
         }
     }
@@ -63,14 +64,18 @@ mod tests {
 
     #[test]
     fn numbers_depend_only_on_pixel_sample_and_dimension() {
-        let a: Vec<f32> = {
-            let mut s = Sampler::new(3, 4, 5);
+        let draw = |seed: u64, x: u32, y: u32| -> Vec<f32> {
+            let mut s = Sampler::new(seed, x, y, 5);
             (0..8).map(|_| s.uniform()).collect()
         };
-        let mut s = Sampler::new(3, 4, 5);
-        assert_eq!(a, (0..8).map(|_| s.uniform()).collect::<Vec<_>>());
-        let mut other = Sampler::new(4, 3, 5);
-        assert_ne!(a[0], other.uniform());
+        let a = draw(0, 3, 4);
+        assert_eq!(a, draw(0, 3, 4));
+        assert_ne!(a[0], draw(0, 4, 3)[0]);
+        let seeded = draw(7, 3, 4);
+        assert!(
+            a.iter().zip(&seeded).all(|(x, y)| x != y),
+            "another seed, other numbers"
+        );
         assert!(a.iter().all(|&x| (0.0..1.0).contains(&x)));
     }
 
@@ -79,7 +84,7 @@ mod tests {
         // 64 bins over 64k draws from many pixels: every bin near 1/64.
         let mut bins = [0u32; 64];
         for p in 0..1024u32 {
-            let mut s = Sampler::new(p % 37, p / 37, p % 5);
+            let mut s = Sampler::new(0, p % 37, p / 37, p % 5);
             for _ in 0..64 {
                 bins[(s.uniform() * 64.0) as usize] += 1;
             }
@@ -90,7 +95,7 @@ mod tests {
     #[test]
     fn square_counts_put_one_sample_in_each_cell() {
         let mut cells = [false; 16];
-        let mut s = Sampler::new(0, 0, 0);
+        let mut s = Sampler::new(0, 0, 0, 0);
         for i in 0..16 {
             let (x, y) = stratified(i, 16, s.uniform(), s.uniform());
             let c = (y * 4.0) as usize * 4 + (x * 4.0) as usize;

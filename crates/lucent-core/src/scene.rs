@@ -1,5 +1,6 @@
 //! A scene ready to render: primitives with their acceleration structure, materials,
-//! lights, the camera and the global settings.
+//! textures, lights and the camera. What is rendered of it — the image's size, the
+//! pixels, the samples — is a [`crate::render::job::RenderJob`], not part of the scene.
 
 use crate::accel::AccelKind;
 use crate::camera::Camera;
@@ -13,14 +14,12 @@ use crate::shading::material::Material;
 use crate::shading::texture::{EnvironmentMap, Texture};
 
 pub struct Scene {
-    pub width: u32,
-    pub height: u32,
     pub camera: Camera,
     pub geometry: Geometry,
     pub materials: Vec<Material>,
+    /// Every light; an emitting primitive (the geometry of a `quadLight`) names its own
+    /// ([`crate::geometry::primitive::Primitive::light`]).
     pub lights: Vec<Light>,
-    /// `spp`: camera samples per pixel, box-filtered.
-    pub samples_per_pixel: u32,
     /// `texture` and `checker`, indexed by the materials' maps.
     pub textures: Vec<Texture>,
     /// `envmap`: what rays that hit nothing see (black without one).
@@ -30,14 +29,11 @@ pub struct Scene {
 
 /// Everything a [`Scene`] is made of, before its acceleration structure is built.
 pub struct SceneParts {
-    pub width: u32,
-    pub height: u32,
     pub camera: Camera,
     pub primitives: Vec<Primitive>,
     pub materials: Vec<Material>,
     pub lights: Vec<Light>,
     pub vertex_normals: Vec<[Vec3A; 3]>,
-    pub samples_per_pixel: u32,
     pub textures: Vec<Texture>,
     pub environment: Option<EnvironmentMap>,
 }
@@ -45,26 +41,20 @@ pub struct SceneParts {
 impl Scene {
     pub fn new(parts: SceneParts, accel: AccelKind) -> Scene {
         let SceneParts {
-            width,
-            height,
             camera,
             primitives,
             materials,
             lights,
             vertex_normals,
-            samples_per_pixel,
             textures,
             environment,
         } = parts;
         Scene {
-            width,
-            height,
             camera,
             geometry: Geometry::new(primitives, vertex_normals, accel),
             accel_kind: accel,
             materials,
             lights,
-            samples_per_pixel,
             textures,
             environment,
         }
@@ -108,16 +98,13 @@ mod tests {
     use crate::ray::PreparedRay;
 
     fn scene_of(primitives: Vec<Primitive>, accel: AccelKind) -> Scene {
-        let camera = Camera::look_at(DVec3::Z, DVec3::ZERO, DVec3::Y, 45.0, 4, 4).unwrap();
+        let camera = Camera::look_at(DVec3::Z, DVec3::ZERO, DVec3::Y, 45.0).unwrap();
         let parts = SceneParts {
-            width: 4,
-            height: 4,
             camera,
             primitives,
             materials: vec![Material::default()],
             lights: Vec::new(),
             vertex_normals: Vec::new(),
-            samples_per_pixel: 1,
             textures: Vec::new(),
             environment: None,
         };

@@ -24,7 +24,7 @@ fn write_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
 }
 
 fn io_write_error(path: &Path, e: &std::io::Error) -> ImageError {
-    write_error(path, crate::cse167::io_reason(e))
+    write_error(path, crate::files::io_reason(e))
 }
 
 fn temp_path(path: &Path) -> PathBuf {
@@ -113,7 +113,7 @@ pub fn read_rgb8(path: &Path) -> Result<Rgb8Image, ImageError> {
         path: path.display().to_string(),
         reason: e.to_string(),
     };
-    let reader = image::ImageReader::open(path).map_err(|e| err(&crate::cse167::io_reason(&e)))?;
+    let reader = image::ImageReader::open(path).map_err(|e| err(&crate::files::io_reason(&e)))?;
     let reader = reader.with_guessed_format().map_err(|e| err(&e))?;
     let img = reader.decode().map_err(|e| err(&e))?.to_rgb8();
     Ok(Rgb8Image {

@@ -102,7 +102,7 @@ impl PropertyAccess for Face {
 /// The vertices and faces of a PLY file, faces checked (at least three corners, every
 /// index a vertex).
 fn read_ply(path: &Path) -> Result<(Vec<Vertex>, Vec<Face>), String> {
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {}", crate::cse167::io_reason(&e)))?;
+    let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {}", crate::files::io_reason(&e)))?;
     let mut reader = BufReader::new(file);
     let bad = |e: std::io::Error| format!("malformed PLY file: {e}");
     let vertex_parser = Parser::<Vertex>::new();

@@ -11,7 +11,7 @@ const MAX_TEXELS: u64 = 1 << 28;
 
 pub fn load_image(path: &Path) -> Result<Image, String> {
     let reader = image::ImageReader::open(path)
-        .map_err(|e| format!("cannot open: {}", crate::cse167::io_reason(&e)))?
+        .map_err(|e| format!("cannot open: {}", crate::files::io_reason(&e)))?
         .with_guessed_format()
         .map_err(|e| format!("cannot read: {e}"))?;
     let img = reader.decode().map_err(|e| format!("cannot decode the image: {e}"))?;

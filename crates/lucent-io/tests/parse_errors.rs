@@ -361,8 +361,8 @@ fn state_is_captured_per_object() {
     let (desc, diags) = parse_bytes("t.test", text.as_bytes(), ParseOptions::default());
     assert!(!diags.has_errors());
     let [a, b] = [desc.shapes[0], desc.shapes[1]];
-    assert_eq!(desc.materials[a.material as usize].base.diffuse.x, 1.0);
-    assert_eq!(desc.materials[b.material as usize].base.diffuse.y, 1.0);
+    assert_eq!(desc.materials[a.material as usize].diffuse.x, 1.0);
+    assert_eq!(desc.materials[b.material as usize].diffuse.y, 1.0);
     assert_eq!(desc.transforms[a.transform as usize].point(glam::DVec3::ZERO).z, 2.0);
     assert!(desc.transforms[b.transform as usize].is_identity());
     match desc.lights[0].kind {
@@ -426,7 +426,7 @@ fn bezier_patch_files() {
     .unwrap();
     let scene = dir.join("s.test");
     let name = scene.display().to_string();
-    let errors = |line: &str| common::parse_errors(&name, &format!("{HEADER}{line}\n"));
+    let errors = |line: &str| common::errors(&name, &format!("{HEADER}{line}\n"));
     let bad = dir.join("bad.bpt").display().to_string();
     let missing = dir.join("missing.bpt").display().to_string();
     assert_eq!(
@@ -453,15 +453,32 @@ fn bezier_patch_files() {
 #[test]
 fn the_shipped_teapot_scene_tessellates() {
     // 32 patches × 16 × 16 quads × 2 triangles, less the empty ones at the poles.
+    use lucent_core::geometry::primitive::Shape;
+    use lucent_io::session::{Session, SessionOptions};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.test");
-    let (desc, diags) = lucent_io::cse167::parse_file(&path, ParseOptions { strict: true });
+    let options = SessionOptions {
+        strict: true,
+        accel: lucent_core::accel::AccelKind::List,
+    };
+    let session = Session::open(&path, options);
+    let (desc, diags) = (&session.desc, &session.diags);
     assert!(
         !diags.has_errors() && diags.items.is_empty(),
         "{}",
         diags.render(&desc.sources)
     );
     assert_eq!(desc.shapes.len(), 2, "one mesh and the floor plane");
-    let mesh = &desc.meshes[0];
+    let built = session.built.as_ref().unwrap();
+    let mesh = built
+        .scene
+        .geometry
+        .primitives
+        .iter()
+        .find_map(|p| match &p.shape {
+            Shape::Mesh(m) => Some(&m.mesh),
+            _ => None,
+        })
+        .unwrap();
     let tris = mesh.indices.len();
     assert!((16_000..=16_384).contains(&tris), "{tris}");
     assert_eq!(mesh.positions.len(), 32 * 17 * 17);

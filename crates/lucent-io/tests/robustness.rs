@@ -2,8 +2,8 @@
 //! valid scene (a deterministic fuzzer that runs with the tests; `fuzz/` has the
 //! coverage-guided one).
 
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_bytes, ParseOptions};
+use lucent_io::cse167::{command_names, parse_bytes, ParseOptions};
+use lucent_io::session::{Session, SessionOptions};
 
 const SEED_SCENE: &str = "size 16 12\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 3\nattenuation 1 0.1 0.01\npoint 1 2 3 1 1 1\ndirectional 0 1 1 .5 .5 .5\nmaxverts 4\nvertex -1 -1 0\nvertex 1 -1 0\nvertex 1 1 0\nvertexnormal 0 0 0 0 0 1\nvertexnormal 1 0 0 0 1 1\nvertexnormal 0 1 0 1 0 1\ndiffuse 0.5 0.2 0.1\nspecular .3 .3 .3\nshininess 20\npushTransform\nrotate 0 1 0 30\nscale 1 2 0.5\nsphere 0 0 0 1\ntri 0 1 2\ntrinormal 0 1 2\npopTransform\nplane 0 -1 0 0 1 0\nbox -1 -1 -1 1 1 1\ncylinder 1 -1 1\ndisk 1\ncone 1 2\nquadric 1 1 -1 0 0 0 0 0 0 -0.1 -1 -1 -1 1 1 1\nnurbs 2 1 3 2\nknotsu 0 0 0 1 1 1\nknotsv 0 0 1 1\ncpoint 0 0 0 1\ncpoint 1 0 1 .7\ncpoint 2 0 0 1\ncpoint 0 1 0 1\ncpoint 1 1 1 .7\ncpoint 2 1 0 1\nobjectbegin thing\nsphere 0 0 0 1\ntri 0 1 2\nobjectend\npushTransform\ntranslate 1 0 0\ninstance thing\npopTransform\nintegrator raytracer\ngamma 2.2\n";
 
@@ -20,6 +20,7 @@ impl Rng {
     }
 }
 
+/// Tokens worth inserting besides every command name and the seed's own tokens.
 const INTERESTING: &[&str] = &[
     "0",
     "-1",
@@ -35,24 +36,7 @@ const INTERESTING: &[&str] = &[
     "\u{ff}",
     "#",
     "\t",
-    "popTransform",
-    "pushTransform",
-    "objectbegin",
-    "objectend",
-    "instance",
     "thing",
-    "tri",
-    "sphere",
-    "plane",
-    "box",
-    "cylinder",
-    "disk",
-    "cone",
-    "quadric",
-    "nurbs",
-    "knotsu",
-    "cpoint",
-    "size",
     "4294967296",
     "-2147483649",
     "\r",
@@ -69,6 +53,7 @@ fn random_mutations_never_panic() {
     );
     let mut rng = Rng(0x5eed);
     let tokens: Vec<&str> = SEED_SCENE.split([' ', '\n']).collect();
+    let interesting: Vec<&str> = INTERESTING.iter().copied().chain(command_names()).collect();
     for _ in 0..3000 {
         let mut bytes = SEED_SCENE.as_bytes().to_vec();
         for _ in 0..1 + rng.below(6) {
@@ -79,7 +64,7 @@ fn random_mutations_never_panic() {
                     bytes.remove(pos);
                 }
                 2 => {
-                    let t = INTERESTING[rng.below(INTERESTING.len())];
+                    let t = interesting[rng.below(interesting.len())];
                     bytes.splice(pos..pos, t.bytes());
                 }
                 3 => {
@@ -92,28 +77,25 @@ fn random_mutations_never_panic() {
                 }
             }
         }
-        let (desc, mut diags) = parse_bytes(
-            "fuzz.test",
-            &bytes,
-            ParseOptions {
-                strict: rng.below(2) == 0,
-            },
-        );
-        if !diags.has_errors() {
-            // Keep the render cheap: whatever size survived, shrink it.
-            if let Some(built) = build(&desc, &BuildOptions::default(), &mut diags) {
-                // A few rays across the picture, with the shading data of what they hit.
-                let scene = built.scene;
-                for k in 0..16 {
-                    let (x, y) = ((k % 4) as f64 * 4.0 + 0.5, (k / 4) as f64 * 3.0 + 0.5);
-                    let ray = scene.camera.ray(x, y, (0.5, 0.5));
-                    if let Some(hit) = scene.closest_hit(&ray) {
-                        let _ = scene.surface_point(&hit, &ray);
-                    }
-                    let _ = scene.occluded(&ray);
+        let options = SessionOptions {
+            strict: rng.below(2) == 0,
+            ..SessionOptions::default()
+        };
+        let mut session = Session::parse_text("fuzz.test", &bytes, options);
+        if session.build() {
+            // A few rays across the picture, with the shading data of what they hit.
+            let built = session.built.as_ref().unwrap();
+            let scene = &built.scene;
+            let resolution = built.settings.resolution;
+            for k in 0..16 {
+                let (x, y) = ((k % 4) as f64 * 4.0 + 0.5, (k / 4) as f64 * 3.0 + 0.5);
+                let ray = scene.camera.ray(resolution, x, y, (0.5, 0.5));
+                if let Some(hit) = scene.closest_hit(&ray) {
+                    let _ = scene.surface_point(&hit, &ray);
                 }
+                let _ = scene.occluded(&ray);
             }
         }
-        let _ = diags.render(&desc.sources);
+        let _ = session.diags.render(&session.desc.sources);
     }
 }

@@ -13,7 +13,7 @@ fn render_film(scene: &str, text: &str) -> Vec<[f32; 3]> {
 }
 
 fn errors(scene: &str, text: &str) -> Vec<String> {
-    common::parse_errors(scene, text)
+    common::errors(scene, text)
 }
 
 /// A unit square `[0, 1]²` in z = 0 facing +z, its texture coordinates its x and y (two

@@ -5,9 +5,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_file, ParseOptions};
-use lucent_io::desc::{LightKind, ShapeKind};
+use lucent_io::desc::{LightKind, ProjectionDesc, ShapeKind, SurfaceRecipe};
+use lucent_io::session::{Session, SessionOptions};
 
 use crate::output::report;
 use crate::EXIT_BAD_INPUT;
@@ -22,19 +21,21 @@ pub struct CheckArgs {
 }
 
 pub fn run(args: &CheckArgs) -> u8 {
-    let (desc, mut diags) = parse_file(&args.scene, ParseOptions { strict: args.strict });
     // The list needs no build time and reports the same problems as the BVH.
-    let built = if diags.has_errors() {
-        None
-    } else {
-        build(&desc, &BuildOptions { accel: AccelKind::List }, &mut diags)
+    let options = SessionOptions {
+        strict: args.strict,
+        accel: AccelKind::List,
     };
-    report(&diags, &desc.sources, true);
-    let Some(built) = built else {
+    let session = Session::open(&args.scene, options);
+    report(&session.diags, &session.desc.sources, true);
+    let (desc, Some(built)) = (&session.desc, &session.built) else {
         return EXIT_BAD_INPUT;
     };
 
     let count = |f: &dyn Fn(&ShapeKind) -> bool| desc.shapes.iter().filter(|s| f(&s.kind)).count();
+    let surfaces = |f: &dyn Fn(&SurfaceRecipe) -> bool| {
+        count(&|k| matches!(k, ShapeKind::Surface { index } if f(&desc.surfaces[*index as usize].recipe)))
+    };
     let spheres = count(&|k| matches!(k, ShapeKind::Sphere { .. }));
     let tris = count(&|k| matches!(k, ShapeKind::Triangle { .. }));
     let trinormals = count(&|k| matches!(k, ShapeKind::TriNormal { .. }));
@@ -57,8 +58,8 @@ pub fn run(args: &CheckArgs) -> u8 {
         v(c.center),
         v(c.up),
         match c.projection {
-            lucent_core::camera::Projection::Perspective { fovy } => format!("fovy {fovy}"),
-            lucent_core::camera::Projection::Orthographic { height } => format!("orthographic, height {height}"),
+            ProjectionDesc::Perspective { fovy } => format!("fovy {fovy}"),
+            ProjectionDesc::Orthographic { height } => format!("orthographic, height {height}"),
         }
     );
     println!(
@@ -74,8 +75,8 @@ pub fn run(args: &CheckArgs) -> u8 {
         ("disk", count(&|k| matches!(k, ShapeKind::Disk { .. }))),
         ("cone", count(&|k| matches!(k, ShapeKind::Cone { .. }))),
         ("quadric", count(&|k| matches!(k, ShapeKind::Quadric { .. }))),
-        ("nurbs surface", count(&|k| matches!(k, ShapeKind::Nurbs { .. }))),
-        ("mesh", count(&|k| matches!(k, ShapeKind::Mesh { .. }))),
+        ("nurbs surface", surfaces(&|r| matches!(r, SurfaceRecipe::Nurbs(_)))),
+        ("mesh", surfaces(&|r| !matches!(r, SurfaceRecipe::Nurbs(_)))),
         ("object", desc.objects.len()),
         ("instance", count(&|k| matches!(k, ShapeKind::Instance { .. }))),
     ]
@@ -98,7 +99,10 @@ pub fn run(args: &CheckArgs) -> u8 {
         lights(&|k| matches!(k, LightKind::Directional { .. })),
         lights(&|k| matches!(k, LightKind::Quad { .. }))
     );
-    println!("materials:  {}", desc.materials.len());
+    // The scene's materials and its meshes' MTL materials; not the one the build adds for
+    // the surfaces of quad lights.
+    let quad_lights = lights(&|k| matches!(k, LightKind::Quad { .. }));
+    println!("materials:  {}", built.scene.materials.len() - quad_lights.min(1));
     let spp = desc.spp.as_ref().map_or(1, |s| s.value);
     let samples = desc.light_samples.as_ref().map_or(1, |s| s.value);
     let stratified = desc.light_stratify.as_ref().is_some_and(|s| s.value);

@@ -6,10 +6,8 @@ use std::time::Instant;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
-use lucent_core::render::{render, RenderControl};
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_file, ParseOptions};
 use lucent_io::image::check_writable;
+use lucent_io::session::{Renderer, Session, SessionOptions};
 
 use crate::output::{choose_output, report};
 use crate::progress::Progress;
@@ -42,57 +40,48 @@ pub struct RenderArgs {
 pub fn run(args: &RenderArgs) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t_start = Instant::now();
-    let (desc, mut diags) = parse_file(&args.scene, ParseOptions { strict: args.strict });
-    let t_parsed = Instant::now();
-    if diags.has_errors() {
-        report(&diags, &desc.sources, false);
+    let options = SessionOptions {
+        strict: args.strict,
+        accel,
+    };
+    let mut session = Session::parse_file(&args.scene, options);
+    if session.diags.has_errors() {
+        report(&session.diags, &session.desc.sources, false);
         return EXIT_BAD_INPUT;
     }
-
-    let out = match choose_output(args.output.as_deref(), &desc, &mut diags) {
+    // The output is checked before the build, which may take long.
+    let out = match choose_output(args.output.as_deref(), &session.desc, &mut session.diags) {
         Ok(out) => out,
         Err(msg) => {
-            report(&diags, &desc.sources, false);
+            report(&session.diags, &session.desc.sources, false);
             eprintln!("lucent: error: {msg}");
             return EXIT_BAD_INPUT;
         }
     };
     if let Err(e) = check_writable(&out) {
-        report(&diags, &desc.sources, false);
+        report(&session.diags, &session.desc.sources, false);
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
-
-    let t_build = Instant::now();
-    let built = build(&desc, &BuildOptions { accel }, &mut diags);
-    let t_built = Instant::now();
-    report(&diags, &desc.sources, false);
-    let Some(built) = built else {
+    session.build();
+    report(&session.diags, &session.desc.sources, false);
+    let Some(built) = &session.built else {
         return EXIT_BAD_INPUT;
     };
 
-    let pool = match rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-    {
-        Ok(p) => p,
+    let renderer = match Renderer::new(args.threads.map(|n| n as usize)) {
+        Ok(r) => r,
         Err(e) => {
-            eprintln!("lucent: error: cannot start worker threads: {e}");
+            eprintln!("lucent: error: {e}");
             return 1;
         }
     };
-    let scene = &built.scene;
-    let pixels = scene.width as u64 * scene.height as u64;
-    let progress = Progress::new(pixels, args.quiet);
+    let job = built.job();
+    let progress = Progress::new(job.pixels.pixels(), args.quiet);
     let cancel = AtomicBool::new(false);
-    let on_progress = |n: u64| progress.advance(n);
-    let control = RenderControl {
-        progress: &on_progress,
-        cancel: &cancel,
-    };
     let t_render = Instant::now();
-    let (film, stats) = pool
-        .install(|| render(scene, built.integrator.as_ref(), &control))
+    let (film, stats) = renderer
+        .render(built, &job, &|n| progress.advance(n), &cancel)
         .expect("never cancelled");
     let t_rendered = Instant::now();
     progress.finish();
@@ -103,18 +92,19 @@ pub fn run(args: &RenderArgs) -> u8 {
             stats.bad_samples
         );
     }
-    if let Err(e) = crate::output::write_image(&out, &film, built.gamma) {
+    if let Err(e) = crate::output::write_image(&out, &film, built.settings.gamma) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     let t_written = Instant::now();
 
+    let scene = &built.scene;
     let render_s = (t_rendered - t_render).as_secs_f64();
     if !args.quiet {
         eprintln!(
             "{}x{}, {} primitives, {} rays, {:.3} s, {:.2} Mrays/s -> {}",
-            scene.width,
-            scene.height,
+            film.width,
+            film.height,
             scene.geometry.shown_primitive_count(),
             stats.rays,
             render_s,
@@ -125,12 +115,12 @@ pub fn run(args: &RenderArgs) -> u8 {
     if args.stats {
         eprintln!(
             "parse {:.3} s, build {:.3} s ({} {:.1} MB), render {:.3} s on {} threads, write {:.3} s, total {:.3} s",
-            (t_parsed - t_start).as_secs_f64(),
-            (t_built - t_build).as_secs_f64(),
+            session.parse_seconds,
+            session.build_seconds,
             scene.accel_kind().name(),
             scene.accel_memory_bytes() as f64 / 1e6,
             render_s,
-            pool.current_num_threads(),
+            renderer.threads(),
             (t_written - t_rendered).as_secs_f64(),
             (t_written - t_start).as_secs_f64(),
         );

@@ -173,6 +173,7 @@ impl TriangleMesh {
             } else {
                 self.materials[k]
             },
+            light: None,
         }
     }
 }

@@ -36,9 +36,21 @@ pub enum Shape {
 pub struct Primitive {
     pub shape: Shape,
     pub material: u32,
+    /// The light this primitive is the surface of (index into the scene's lights), if it
+    /// emits: a surface point on it knows which light it is.
+    pub light: Option<u32>,
 }
 
 impl Primitive {
+    /// A primitive that does not emit light.
+    pub fn new(shape: Shape, material: u32) -> Primitive {
+        Primitive {
+            shape,
+            material,
+            light: None,
+        }
+    }
+
     pub fn bounds(&self) -> Aabb {
         match &self.shape {
             Shape::Triangle { p, .. } => Aabb::from_points(p),
@@ -167,6 +179,7 @@ impl Primitive {
             normal,
             uv,
             material: self.material,
+            light: self.light,
         }
     }
 }
@@ -209,10 +222,7 @@ mod tests {
             * Affine3A::from_scale(glam::Vec3::new(2.0, 1.0, 1.0));
         let s = Sphere::new(m);
         assert!((s.bounds.max - Vec3A::new(1.0, 2.0, 1.0)).abs().max_element() < 1e-5);
-        let prim = Primitive {
-            shape: Shape::Sphere(s),
-            material: 0,
-        };
+        let prim = Primitive::new(Shape::Sphere(s), 0);
         // A ray down the z axis at (x=0.5, y=0) hits the ellipsoid x² + (y/2)² + z² = 1 at z = sqrt(0.75).
         let ray = Ray::segment(Vec3A::new(0.5, 0.0, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY);
         let t = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY).unwrap().t;
@@ -232,8 +242,8 @@ mod tests {
         // object normal (0, −1, 0) comes back as world +z.
         let m = Affine3A::from_translation(glam::Vec3::new(5.0, 0.0, 0.0))
             * Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2);
-        let prim = Primitive {
-            shape: Shape::Analytic(Box::new(Analytic::new(
+        let prim = Primitive::new(
+            Shape::Analytic(Box::new(Analytic::new(
                 m,
                 AnalyticKind::Cylinder {
                     radius: 1.0,
@@ -241,8 +251,8 @@ mod tests {
                     zmax: 2.0,
                 },
             ))),
-            material: 0,
-        };
+            0,
+        );
         // World bounds: x 4..6, y 0..2, z −1..1, widened by a few units in the last place.
         let b = prim.bounds();
         let (lo, hi) = (Vec3A::new(4.0, 0.0, -1.0), Vec3A::new(6.0, 2.0, 1.0));

@@ -149,13 +149,13 @@ fn degenerate_inputs_match_the_list() {
     prims.extend(std::iter::repeat_n(prims[0].clone(), 40));
     let p = Vec3A::new(1.0, 1.0, 1.0);
     for q in [p, Vec3A::new(2.0, 2.0, 2.0)] {
-        prims.push(Primitive {
-            shape: Shape::Triangle {
+        prims.push(Primitive::new(
+            Shape::Triangle {
                 p: [p, q, p],
                 normals: None,
             },
-            material: 0,
-        });
+            0,
+        ));
     }
     let rays = random_rays(&mut Rng(5), 500, 15.0, 10.0);
     check_against_list(&prims, &rays);

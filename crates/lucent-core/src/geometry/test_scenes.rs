@@ -21,7 +21,7 @@ pub fn soup(seed: u64, n: usize) -> Vec<Primitive> {
                     normals: None,
                 }
             };
-            Primitive { shape, material: 0 }
+            Primitive::new(shape, 0)
         })
         .collect()
 }
@@ -62,10 +62,7 @@ pub fn analytic_soup(seed: u64, n: usize) -> Vec<Primitive> {
             let m = Affine3A::from_translation(rng.vec(10.0).into())
                 * Affine3A::from_axis_angle(rng.vec(1.0).normalize().into(), rng.range(0.0, 6.0))
                 * Affine3A::from_scale(Vec3::new(rng.range(0.3, 2.0), rng.range(0.3, 2.0), rng.range(0.3, 2.0)));
-            Primitive {
-                shape: Shape::Analytic(Box::new(Analytic::new(m, kind))),
-                material: 0,
-            }
+            Primitive::new(Shape::Analytic(Box::new(Analytic::new(m, kind))), 0)
         })
         .collect()
 }
@@ -77,20 +74,20 @@ pub fn coplanar_grid(n: usize) -> Vec<Primitive> {
     for i in 0..n {
         for j in 0..n {
             let p = |a: usize, b: usize| Vec3A::new(a as f32, b as f32, 0.0);
-            prims.push(Primitive {
-                shape: Shape::Triangle {
+            prims.push(Primitive::new(
+                Shape::Triangle {
                     p: [p(i, j), p(i + 1, j), p(i + 1, j + 1)],
                     normals: None,
                 },
-                material: 0,
-            });
-            prims.push(Primitive {
-                shape: Shape::Triangle {
+                0,
+            ));
+            prims.push(Primitive::new(
+                Shape::Triangle {
                     p: [p(i, j), p(i + 1, j + 1), p(i, j + 1)],
                     normals: None,
                 },
-                material: 0,
-            });
+                0,
+            ));
         }
     }
     prims

@@ -64,15 +64,10 @@ impl Whitted {
         *t.rays += 1;
         let hit = scene.closest_hit(ray)?;
         let mut sp = scene.surface_point(&hit, ray);
-        let m = &scene.materials[sp.material as usize];
-        if m.is_light {
-            let seen = if ray.dir.dot(sp.normal) > 0.0 {
-                m.emission
-            } else {
-                Color::ZERO
-            };
-            return Some((seen, sp));
+        if let Some(light) = sp.light {
+            return Some((scene.lights[light as usize].radiance_seen(ray.dir, sp.normal), sp));
         }
+        let m = &scene.materials[sp.material as usize];
         if let Some(bump) = m.bump_map {
             let (dpdu, dpdv) = scene.tangents(&hit, ray);
             sp.normal = bump::bumped_normal(&scene.textures[bump.texture as usize], bump, &sp, dpdu, dpdv);
@@ -142,10 +137,11 @@ impl Whitted {
                 break;
             };
             *total += weight * local;
-            let m = &scene.materials[sp.material as usize];
-            if m.is_light || depth >= self.max_depth {
+            // A light's surface reflects nothing.
+            if sp.light.is_some() || depth >= self.max_depth {
                 break;
             }
+            let m = &scene.materials[sp.material as usize];
             let (d, n) = (ray.dir, sp.normal);
             let mut mirror = m.specular;
             if m.transparent != Color::ZERO {

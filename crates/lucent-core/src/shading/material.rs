@@ -22,9 +22,6 @@ pub struct Material {
     pub diffuse_map: Option<u32>,
     /// `bumpmap`: the texture whose luminance, times `strength`, is a height field.
     pub bump_map: Option<BumpMap>,
-    /// The geometry of a `quadLight`: shows its radiance (`emission`) from the emitting
-    /// side, black from behind, and reflects nothing.
-    pub is_light: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -53,7 +50,6 @@ impl Default for Material {
             glossy: None,
             diffuse_map: None,
             bump_map: None,
-            is_light: false,
         }
     }
 }

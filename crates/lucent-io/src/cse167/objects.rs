@@ -5,7 +5,8 @@
 //! Objects do not nest, cannot hold instances (one level of instancing, as in pbrt) and
 //! cannot hold lights; a name is defined once.
 
-use super::{Command, Parser};
+use super::lexer::Command;
+use super::parser::Parser;
 use crate::desc::{ObjectDesc, ShapeKind};
 
 impl Parser {

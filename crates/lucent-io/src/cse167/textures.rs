@@ -1,18 +1,16 @@
 //! Textures and what uses them: `texture name file`, `checker name r1 g1 b1 r2 g2 b2
-//! scale`, `diffusemap name|off`, `bumpmap name strength|off` (part of the material) and
-//! `envmap file [intensity]` (global). Image files are read here, relative to the scene
-//! file's folder, so that their errors point at the command.
+//! scale`, `diffusemap name|off`, `bumpmap name strength|off` (part of the material),
+//! `displacementmap name scale|off` (for the surfaces that follow) and `envmap file
+//! [intensity]` (global). Image files are only named here; the build reads them.
 
-use super::{Command, Parser};
-use crate::desc::{Located, TextureDesc};
-use crate::texture_file::load_image;
-use lucent_core::shading::material::BumpMap;
-use lucent_core::shading::texture::{EnvironmentMap, Texture};
+use super::lexer::Command;
+use super::parser::Parser;
+use crate::desc::{BumpDesc, DisplacementDesc, EnvironmentDesc, Located, TextureDesc, TextureSource};
 
 impl Parser {
     /// `texture name file` and `checker name r1 g1 b1 r2 g2 b2 scale`.
     pub(super) fn texture(&mut self, c: &Command) {
-        let texture = if c.name.text == "checker" {
+        let source = if c.name.text == "checker" {
             let Some(v) = self.nums_after_name::<7>(c) else { return };
             if !(v[6] > 0.0) {
                 self.err_arg(
@@ -22,25 +20,14 @@ impl Parser {
                 );
                 return;
             }
-            let a = self.color_at(c, 1, &v[0..3]).as_vec3a();
-            let b = self.color_at(c, 4, &v[3..6]).as_vec3a();
-            Texture::Checker {
-                a,
-                b,
-                scale: v[6] as f32,
-            }
+            let a = self.color_at(c, 1, &v[0..3]);
+            let b = self.color_at(c, 4, &v[3..6]);
+            TextureSource::Checker { a, b, scale: v[6] }
         } else {
             if !self.expect_count(c, 2, "a texture name and an image file") {
                 return;
             }
-            let path = self.base_dir.join(c.args[1].text);
-            match load_image(&path) {
-                Ok(img) => Texture::Image(img),
-                Err(e) => {
-                    self.err_arg(c, 1, format!("texture: {}: {e}", path.display()));
-                    return;
-                }
-            }
+            TextureSource::Image(self.file_arg(c, 1))
         };
         let name = c.args[0].text;
         if let Some(t) = self.desc.textures.iter().find(|t| t.name == name) {
@@ -57,7 +44,7 @@ impl Parser {
         }
         self.desc.textures.push(TextureDesc {
             name: name.to_string(),
-            texture,
+            source,
             loc: self.loc(c.line, &c.args[0]),
         });
     }
@@ -80,6 +67,16 @@ impl Parser {
         }
     }
 
+    /// The texture and number of `command name number`; `None` after an error.
+    fn texture_and_number(&mut self, c: &Command, what: &str) -> Option<(u32, f64)> {
+        if !self.expect_count(c, 2, &format!("a texture name and {what}, or 'off'")) {
+            return None;
+        }
+        let number = self.number(c, &c.args[1])?;
+        let texture = self.texture_named(c, 0)?;
+        Some((texture, number))
+    }
+
     /// `diffusemap name` or `diffusemap off`.
     pub(super) fn diffuse_map(&mut self, c: &Command) {
         if !self.expect_count(c, 1, "a texture name or 'off'") {
@@ -91,51 +88,34 @@ impl Parser {
             let Some(t) = self.texture_named(c, 0) else { return };
             Some(t)
         };
-        self.material.base.diffuse_map = map;
-        self.material_id = None;
+        self.set_material(|m| m.diffuse_map = map);
     }
 
     /// `bumpmap name strength` or `bumpmap off`.
     pub(super) fn bump_map(&mut self, c: &Command) {
-        if c.args.len() == 1 && c.args[0].text == "off" {
-            self.material.base.bump_map = None;
-            self.material_id = None;
-            return;
-        }
-        if !self.expect_count(c, 2, "a texture name and a strength, or 'off'") {
-            return;
-        }
-        let Some(strength) = self.number(c, &c.args[1]) else {
-            return;
+        let map = if Self::is_off(c) {
+            None
+        } else {
+            let Some((texture, strength)) = self.texture_and_number(c, "a strength") else {
+                return;
+            };
+            Some(BumpDesc { texture, strength })
         };
-        let Some(texture) = self.texture_named(c, 0) else {
-            return;
-        };
-        self.material.base.bump_map = Some(BumpMap {
-            texture,
-            strength: strength as f32,
-        });
-        self.material_id = None;
+        self.set_material(|m| m.bump_map = map);
     }
 
     /// `displacementmap name scale` or `displacementmap off`: parser state, not part of
     /// the material; it applies to the meshes, subdivision surfaces, patches and NURBS
     /// that follow.
     pub(super) fn displacement_map(&mut self, c: &Command) {
-        if c.args.len() == 1 && c.args[0].text == "off" {
-            self.displacement = None;
-            return;
-        }
-        if !self.expect_count(c, 2, "a texture name and a scale, or 'off'") {
-            return;
-        }
-        let Some(scale) = self.number(c, &c.args[1]) else {
-            return;
+        self.displacement = if Self::is_off(c) {
+            None
+        } else {
+            let Some((texture, scale)) = self.texture_and_number(c, "a scale") else {
+                return;
+            };
+            Some(DisplacementDesc { texture, scale })
         };
-        let Some(texture) = self.texture_named(c, 0) else {
-            return;
-        };
-        self.displacement = Some((texture, scale as f32));
     }
 
     /// `envmap file [intensity]`.
@@ -163,33 +143,13 @@ impl Parser {
                 None => return,
             },
         };
-        let path = self.base_dir.join(c.args[0].text);
-        let image = match load_image(&path) {
-            Ok(img) => img,
-            Err(e) => {
-                self.err_arg(c, 0, format!("envmap: {}: {e}", path.display()));
-                return;
-            }
-        };
         let v = Located {
-            value: EnvironmentMap {
-                image,
-                intensity: intensity as f32,
+            value: EnvironmentDesc {
+                file: self.file_arg(c, 0),
+                intensity,
             },
             loc: self.loc(c.line, &c.name),
         };
         self.set_global(c, |d| &mut d.environment, v);
-    }
-
-    /// The numbers after a leading name argument (`checker name …`).
-    fn nums_after_name<const N: usize>(&mut self, c: &Command) -> Option<[f64; N]> {
-        if !self.expect_count(c, N + 1, &format!("a name and {N} numbers")) {
-            return None;
-        }
-        let mut out = [0.0; N];
-        for (k, slot) in out.iter_mut().enumerate() {
-            *slot = self.number(c, &c.args[k + 1])?;
-        }
-        Some(out)
     }
 }

@@ -44,22 +44,22 @@ pub fn render_scene(
     accel: lucent_core::accel::AccelKind,
     threads: usize,
 ) -> (lucent_core::film::Film, f32) {
-    use lucent_io::build::{build, BuildOptions};
-    use lucent_io::cse167::{parse_bytes, ParseOptions};
-    let (desc, mut diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
-    let built =
-        build(&desc, &BuildOptions { accel }, &mut diags).unwrap_or_else(|| panic!("{}", diags.render(&desc.sources)));
-    assert!(!diags.has_errors(), "{}", diags.render(&desc.sources));
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    use lucent_io::session::{Renderer, Session, SessionOptions};
+    let mut session = Session::parse_text(scene, text.as_bytes(), SessionOptions { strict: false, accel });
+    session.build();
+    let built = session
+        .built
+        .as_ref()
+        .unwrap_or_else(|| panic!("{}", session.diags.render(&session.desc.sources)));
+    assert!(
+        !session.diags.has_errors(),
+        "{}",
+        session.diags.render(&session.desc.sources)
+    );
+    let renderer = Renderer::new(Some(threads)).unwrap();
     let cancel = std::sync::atomic::AtomicBool::new(false);
-    let control = lucent_core::render::RenderControl {
-        progress: &|_| {},
-        cancel: &cancel,
-    };
-    let (film, _) = pool
-        .install(|| lucent_core::render::render(&built.scene, built.integrator.as_ref(), &control))
-        .unwrap();
-    (film, built.gamma)
+    let (film, _) = renderer.render(built, &built.job(), &|_| {}, &cancel).unwrap();
+    (film, built.settings.gamma)
 }
 
 /// [`render_scene`] as 8-bit RGB.
@@ -68,28 +68,29 @@ pub fn render_rgb8(scene: &str, text: &str, accel: lucent_core::accel::AccelKind
     film.to_rgb8(gamma)
 }
 
-/// `line:col: message` of every error the parser reports (the build is not run).
-pub fn parse_errors(scene: &str, text: &str) -> Vec<String> {
-    use lucent_io::cse167::{parse_bytes, ParseOptions};
-    let (_, diags) = parse_bytes(scene, text.as_bytes(), ParseOptions::default());
-    diags
-        .items
-        .iter()
-        .filter(|d| d.severity == lucent_io::diag::Severity::Error)
-        .map(|d| format!("{}:{}: {}", d.loc.line, d.loc.col, d.message))
+/// `line:col: message` of every error the parser and the build report.
+pub fn errors(scene: &str, text: &str) -> Vec<String> {
+    diagnostics(scene, text, false)
+        .into_iter()
+        .filter_map(|d| {
+            let (place, rest) = d.split_once(": error: ")?;
+            Some(format!("{place}: {rest}"))
+        })
         .collect()
 }
 
 /// `line:col: severity: message` of every error and warning of parse and build, in
 /// order (notes left out).
 pub fn diagnostics(scene: &str, text: &str, strict: bool) -> Vec<String> {
-    use lucent_io::build::{build, BuildOptions};
-    use lucent_io::cse167::{parse_bytes, ParseOptions};
-    let (desc, mut diags) = parse_bytes(scene, text.as_bytes(), ParseOptions { strict });
-    if !diags.has_errors() {
-        build(&desc, &BuildOptions::default(), &mut diags);
-    }
-    diags
+    use lucent_io::session::{Session, SessionOptions};
+    let options = SessionOptions {
+        strict,
+        ..SessionOptions::default()
+    };
+    let mut session = Session::parse_text(scene, text.as_bytes(), options);
+    session.build();
+    session
+        .diags
         .items
         .iter()
         .filter(|d| d.severity != lucent_io::diag::Severity::Note)

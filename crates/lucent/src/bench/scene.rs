@@ -9,9 +9,7 @@ use std::time::Instant;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
-use lucent_core::render::{render, RenderControl};
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_file, ParseOptions};
+use lucent_io::session::{Renderer, Session, SessionOptions};
 
 use crate::output::report;
 use crate::EXIT_BAD_INPUT;
@@ -31,35 +29,28 @@ pub struct SceneBenchArgs {
 
 pub fn run(args: &SceneBenchArgs) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
-    let t0 = Instant::now();
-    let (desc, mut diags) = parse_file(&args.scene, ParseOptions::default());
-    let parse_s = t0.elapsed().as_secs_f64();
-    let t1 = Instant::now();
-    let built = if diags.has_errors() {
-        None
-    } else {
-        build(&desc, &BuildOptions { accel }, &mut diags)
+    let options = SessionOptions { strict: false, accel };
+    let session = Session::open(&args.scene, options);
+    report(&session.diags, &session.desc.sources, false);
+    let Some(built) = &session.built else {
+        return EXIT_BAD_INPUT;
     };
-    let build_s = t1.elapsed().as_secs_f64();
-    report(&diags, &desc.sources, false);
-    let Some(built) = built else { return EXIT_BAD_INPUT };
+    let (parse_s, build_s) = (session.parse_seconds, session.build_seconds);
 
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0) as usize)
-        .build()
-        .expect("thread pool");
-    let cancel = AtomicBool::new(false);
-    let control = RenderControl {
-        progress: &|_| {},
-        cancel: &cancel,
+    let renderer = match Renderer::new(args.threads.map(|n| n as usize)) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return 1;
+        }
     };
+    let job = built.job();
+    let cancel = AtomicBool::new(false);
     let mut times = Vec::new();
     let mut rays = 0;
     for _ in 0..args.reps {
         let t = Instant::now();
-        let (_, stats) = pool
-            .install(|| render(&built.scene, built.integrator.as_ref(), &control))
-            .expect("not cancelled");
+        let (_, stats) = renderer.render(built, &job, &|_| {}, &cancel).expect("not cancelled");
         times.push(t.elapsed().as_secs_f64());
         rays = stats.rays;
     }
@@ -71,7 +62,7 @@ pub fn run(args: &SceneBenchArgs) -> u8 {
     println!(
         "scene={name} accel={} threads={} parse_s={parse_s:.4} build_s={build_s:.4} render_s={median:.4} rays={rays} mrays_per_s={:.2} reps={}",
         accel.name(),
-        pool.current_num_threads(),
+        renderer.threads(),
         rays as f64 / median / 1e6,
         args.reps
     );

@@ -1,12 +1,15 @@
-//! The render loop: the image is cut into square tiles, rayon spreads the tiles over the
-//! threads of the current pool, and each pixel's value depends only on the pixel, never
-//! on which thread or in which order its tile ran — so the output is the same bytes for
-//! any thread count.
+//! The render loop: the job's pixels are cut into square tiles (on a grid fixed by the
+//! whole image), rayon spreads the tiles over the threads of the current pool, and each
+//! pixel's value depends only on the pixel and the job, never on which thread or in which
+//! order its tile ran — so the output is the same bytes for any thread count, and a crop
+//! is exactly that part of the whole image.
 //!
 //! The path of one pixel: [`render`] → `render_tile` → [`Camera::ray`] through the pixel
 //! centre → [`Integrator::radiance`] → the film.
 //!
 //! [`Camera::ray`]: crate::camera::Camera::ray
+
+pub mod job;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -17,6 +20,7 @@ use crate::integrator::Integrator;
 use crate::math::Color;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
+use job::RenderJob;
 
 pub const TILE_SIZE: u32 = 16;
 
@@ -43,16 +47,29 @@ struct Tile {
     y1: u32,
 }
 
-/// Renders `scene` with `integrator` on the current rayon pool. `None` if cancelled.
-pub fn render(scene: &Scene, integrator: &dyn Integrator, control: &RenderControl) -> Option<(Film, RenderStats)> {
-    let (w, h) = (scene.width, scene.height);
-    let tiles: Vec<Tile> = (0..h.div_ceil(TILE_SIZE))
+/// Renders the job's pixels of `scene` with `integrator` on the current rayon pool: a film
+/// the size of `job.pixels`. `None` if cancelled.
+///
+/// # Panics
+/// If the job is not valid ([`RenderJob::check`]).
+pub fn render(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    job: &RenderJob,
+    control: &RenderControl,
+) -> Option<(Film, RenderStats)> {
+    if let Err(e) = job.check() {
+        panic!("render: {e}");
+    }
+    let rect = job.pixels;
+    // Tiles of the whole image's grid, clipped to the rectangle.
+    let tiles: Vec<Tile> = (rect.y0 / TILE_SIZE..rect.y1.div_ceil(TILE_SIZE))
         .flat_map(|ty| {
-            (0..w.div_ceil(TILE_SIZE)).map(move |tx| Tile {
-                x0: tx * TILE_SIZE,
-                y0: ty * TILE_SIZE,
-                x1: ((tx + 1) * TILE_SIZE).min(w),
-                y1: ((ty + 1) * TILE_SIZE).min(h),
+            (rect.x0 / TILE_SIZE..rect.x1.div_ceil(TILE_SIZE)).map(move |tx| Tile {
+                x0: (tx * TILE_SIZE).max(rect.x0),
+                y0: (ty * TILE_SIZE).max(rect.y0),
+                x1: ((tx + 1) * TILE_SIZE).min(rect.x1),
+                y1: ((ty + 1) * TILE_SIZE).min(rect.y1),
             })
         })
         .collect();
@@ -63,13 +80,14 @@ pub fn render(scene: &Scene, integrator: &dyn Integrator, control: &RenderContro
             if control.cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let out = render_tile(scene, integrator, tile);
+            let out = render_tile(scene, integrator, job, tile);
             (control.progress)(out.0.len() as u64);
             Some(out)
         })
         .collect();
 
-    let mut film = Film::new(w, h);
+    let w = rect.width() as usize;
+    let mut film = Film::new(rect.width(), rect.height());
     let mut stats = RenderStats::default();
     for (tile, result) in tiles.iter().zip(results) {
         let (pixels, s) = result?;
@@ -77,26 +95,27 @@ pub fn render(scene: &Scene, integrator: &dyn Integrator, control: &RenderContro
         stats.bad_samples += s.bad_samples;
         let tw = (tile.x1 - tile.x0) as usize;
         for (row, chunk) in pixels.chunks(tw).enumerate() {
-            let start = (tile.y0 as usize + row) * w as usize + tile.x0 as usize;
+            let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
             film.pixels[start..start + tw].copy_from_slice(chunk);
         }
     }
     Some((film, stats))
 }
 
-fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<Color>, RenderStats) {
+fn render_tile(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob, tile: &Tile) -> (Vec<Color>, RenderStats) {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut stats = RenderStats::default();
-    let n = scene.samples_per_pixel.max(1);
+    let n = job.spp.max(1);
+    let taken = job.samples.len() as u32;
     let mut lens_strata: Vec<u32> = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
             if scene.camera.has_lens() {
-                lens_strata = shuffled_strata(x, y, n, lens_strata);
+                lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
             }
             let mut sum = Color::ZERO;
-            for i in 0..n {
-                let mut sampler = Sampler::new(x, y, i);
+            for i in job.samples.clone() {
+                let mut sampler = Sampler::new(job.seed, x, y, i);
                 // One sample goes through the pixel centre; more are jittered over the
                 // pixel (one per cell of a √n × √n grid when n is a square).
                 let (dx, dy) = if n == 1 {
@@ -113,7 +132,9 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<
                 } else {
                     (0.5, 0.5)
                 };
-                let ray = scene.camera.ray(x as f64 + dx as f64, y as f64 + dy as f64, lens);
+                let ray = scene
+                    .camera
+                    .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
                 let c = integrator.radiance(scene, &ray, &mut sampler, &mut stats.rays);
                 if c.is_finite() {
                     sum += c;
@@ -122,17 +143,17 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, tile: &Tile) -> (Vec<
                 }
             }
             // The box filter: every sample of the pixel counts the same.
-            pixels.push(if n == 1 { sum } else { sum / n as f32 });
+            pixels.push(if taken == 1 { sum } else { sum / taken as f32 });
         }
     }
     (pixels, stats)
 }
 
 /// `0..n` in an order drawn from the pixel alone (Fisher–Yates), reusing `out`'s storage.
-fn shuffled_strata(x: u32, y: u32, n: u32, mut out: Vec<u32>) -> Vec<u32> {
+fn shuffled_strata(seed: u64, x: u32, y: u32, n: u32, mut out: Vec<u32>) -> Vec<u32> {
     out.clear();
     out.extend(0..n);
-    let mut rng = Sampler::new(x, y, u32::MAX);
+    let mut rng = Sampler::new(seed, x, y, u32::MAX);
     for i in (1..n as usize).rev() {
         let j = ((rng.uniform() * (i + 1) as f32) as usize).min(i);
         out.swap(i, j);
@@ -146,12 +167,12 @@ mod tests {
 
     #[test]
     fn lens_strata_are_a_permutation_fixed_by_the_pixel() {
-        let a = shuffled_strata(3, 7, 16, Vec::new());
+        let a = shuffled_strata(0, 3, 7, 16, Vec::new());
         let mut sorted = a.clone();
         sorted.sort_unstable();
         assert_eq!(sorted, (0..16).collect::<Vec<_>>());
-        assert_eq!(a, shuffled_strata(3, 7, 16, vec![9; 40]));
+        assert_eq!(a, shuffled_strata(0, 3, 7, 16, vec![9; 40]));
         assert_ne!(a, (0..16).collect::<Vec<_>>(), "not the pixel strata's order");
-        assert_ne!(a, shuffled_strata(4, 7, 16, Vec::new()));
+        assert_ne!(a, shuffled_strata(0, 4, 7, 16, Vec::new()));
     }
 }

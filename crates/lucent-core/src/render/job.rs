@@ -1,0 +1,92 @@
+//! What a render is asked to make, apart from the scene it is made of: the whole image's
+//! resolution, the rectangle of pixels to compute, the samples to take in each of them
+//! and the seed of their random numbers. The scene file supplies the defaults (`size`,
+//! `spp`); a crop, a range of samples or another seed is another job over the same scene.
+
+use std::ops::Range;
+
+use crate::camera::Resolution;
+
+/// A rectangle of pixels, `x0 ≤ x < x1`, `y0 ≤ y < y1` (row 0 at the top).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PixelRect {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl PixelRect {
+    pub fn whole(resolution: Resolution) -> PixelRect {
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: resolution.width,
+            y1: resolution.height,
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.x1 - self.x0
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1 - self.y0
+    }
+
+    pub fn pixels(&self) -> u64 {
+        self.width() as u64 * self.height() as u64
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RenderJob {
+    /// The whole image the camera's view is divided into.
+    pub resolution: Resolution,
+    /// The pixels to compute: the whole image, or a part of it. Each pixel's value
+    /// depends only on the pixel, so a part is exactly that part of the whole.
+    pub pixels: PixelRect,
+    /// Samples per pixel of the complete picture (`spp`): where in the pixel each sample
+    /// falls depends on it (one per cell of a √spp × √spp grid when it is a square).
+    pub spp: u32,
+    /// The sample indices taken in every pixel, within `0..spp`; the pixel's value is
+    /// their average.
+    pub samples: Range<u32>,
+    /// Picks the random numbers of every sample; 0 is the default.
+    pub seed: u64,
+}
+
+impl RenderJob {
+    /// The whole image with every one of its `spp` samples.
+    pub fn whole(resolution: Resolution, spp: u32) -> RenderJob {
+        RenderJob {
+            resolution,
+            pixels: PixelRect::whole(resolution),
+            spp,
+            samples: 0..spp,
+            seed: 0,
+        }
+    }
+
+    /// Why the job cannot be rendered, if it cannot: an empty or out-of-image
+    /// rectangle, or a sample range that is empty or outside `0..spp`.
+    pub fn check(&self) -> Result<(), String> {
+        let (r, p) = (self.resolution, self.pixels);
+        if r.width == 0 || r.height == 0 {
+            return Err(format!("the image has no pixels ({} x {})", r.width, r.height));
+        }
+        if !(p.x0 < p.x1 && p.y0 < p.y1 && p.x1 <= r.width && p.y1 <= r.height) {
+            return Err(format!(
+                "pixels {}..{} x {}..{} are not a rectangle inside the {} x {} image",
+                p.x0, p.x1, p.y0, p.y1, r.width, r.height
+            ));
+        }
+        if !(self.samples.start < self.samples.end && self.samples.end <= self.spp) {
+            return Err(format!(
+                "samples {}..{} are not a range within 0..{}",
+                self.samples.start, self.samples.end, self.spp
+            ));
+        }
+        Ok(())
+    }
+}

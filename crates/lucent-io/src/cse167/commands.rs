@@ -1,0 +1,169 @@
+//! The command table: every command the parser knows, with the function that reads it.
+//! The same table dispatches each line, offers the did-you-mean suggestion for a
+//! misspelt name, and lists the commands for the tests and the documentation check.
+
+use std::collections::HashMap;
+use std::sync::OnceLock;
+
+use super::lexer::Command;
+use super::parser::Parser;
+
+type Run = fn(&mut Parser, &Command);
+
+/// Every command, grouped by the file that reads it.
+const COMMANDS: &[(&str, Run)] = &[
+    // settings.rs: the image and the integrator
+    ("size", Parser::size),
+    ("output", Parser::output),
+    ("maxdepth", Parser::max_depth),
+    ("gamma", Parser::gamma),
+    ("integrator", Parser::integrator),
+    ("spp", Parser::sample_count),
+    ("lightsamples", Parser::sample_count),
+    ("lightstratify", Parser::switch),
+    ("russianroulette", Parser::switch),
+    ("nexteventestimation", Parser::next_event_estimation),
+    ("importancesampling", Parser::importance_sampling),
+    // camera.rs
+    ("camera", Parser::camera),
+    ("orthocamera", Parser::camera),
+    ("lens", Parser::lens),
+    // transforms.rs
+    ("translate", Parser::translate),
+    ("rotate", Parser::rotate),
+    ("scale", Parser::scale),
+    ("pushTransform", Parser::push_transform),
+    ("popTransform", Parser::pop_transform),
+    // lights.rs
+    ("directional", Parser::directional),
+    ("point", Parser::point),
+    ("attenuation", Parser::attenuation),
+    ("quadLight", Parser::quad_light),
+    // materials.rs
+    ("ambient", Parser::material_color),
+    ("diffuse", Parser::material_color),
+    ("specular", Parser::material_color),
+    ("emission", Parser::material_color),
+    ("shininess", Parser::shininess),
+    ("transparent", Parser::material_color),
+    ("ior", Parser::ior),
+    ("glossy", Parser::glossy),
+    ("brdf", Parser::brdf),
+    ("roughness", Parser::roughness),
+    // textures.rs
+    ("texture", Parser::texture),
+    ("checker", Parser::texture),
+    ("diffusemap", Parser::diffuse_map),
+    ("bumpmap", Parser::bump_map),
+    ("displacementmap", Parser::displacement_map),
+    ("envmap", Parser::environment),
+    // geometry.rs
+    ("sphere", Parser::sphere),
+    ("plane", Parser::analytic),
+    ("box", Parser::analytic),
+    ("cylinder", Parser::analytic),
+    ("disk", Parser::analytic),
+    ("cone", Parser::analytic),
+    ("quadric", Parser::analytic),
+    ("maxverts", Parser::max_verts),
+    ("maxvertnorms", Parser::max_verts),
+    ("vertex", Parser::vertex),
+    ("vertexnormal", Parser::vertex_normal),
+    ("tri", Parser::triangle),
+    ("trinormal", Parser::triangle),
+    // surfaces.rs
+    ("mesh", Parser::mesh),
+    ("subdivmesh", Parser::subdiv_mesh),
+    ("bezierpatches", Parser::bezier_patches),
+    // nurbs.rs
+    ("nurbs", Parser::nurbs_header),
+    ("knotsu", Parser::nurbs_part),
+    ("knotsv", Parser::nurbs_part),
+    ("cpoint", Parser::nurbs_part),
+    // objects.rs
+    ("objectbegin", Parser::object_begin),
+    ("objectend", Parser::object_end),
+    ("instance", Parser::instance),
+];
+
+/// The name of every command the parser knows.
+pub fn command_names() -> impl Iterator<Item = &'static str> {
+    COMMANDS.iter().map(|(name, _)| *name)
+}
+
+fn table() -> &'static HashMap<&'static str, Run> {
+    static TABLE: OnceLock<HashMap<&'static str, Run>> = OnceLock::new();
+    TABLE.get_or_init(|| COMMANDS.iter().copied().collect())
+}
+
+impl Parser {
+    /// Runs command `c`; an unknown name is a warning (an error with `--strict`) with a
+    /// suggestion for a near miss.
+    pub fn run(&mut self, c: &Command) {
+        self.interrupt_nurbs(c);
+        match table().get(c.name.text) {
+            Some(run) => run(self, c),
+            None => {
+                let name = c.name.text;
+                let hint = suggestion(name).map_or(String::new(), |s| format!("; did you mean '{s}'?"));
+                let loc = self.loc(c.line, &c.name);
+                if self.options.strict {
+                    self.diags.error(loc, format!("unknown command '{name}'{hint}"));
+                } else {
+                    self.diags
+                        .warning(loc, format!("unknown command '{name}' ignored{hint}"));
+                }
+            }
+        }
+    }
+}
+
+/// The known command closest to a misspelt one: same letters ignoring case, or at most
+/// two edits away.
+fn suggestion(name: &str) -> Option<&'static str> {
+    let lower = name.to_lowercase();
+    if let Some(c) = command_names().find(|c| c.to_lowercase() == lower) {
+        return Some(c);
+    }
+    command_names()
+        .map(|c| (edit_distance(&lower, &c.to_lowercase()), c))
+        .filter(|(d, _)| *d <= 2)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + (ca != cb) as usize).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_suggestions_find_near_misses() {
+        assert_eq!(table().len(), COMMANDS.len(), "a command is listed twice");
+        assert_eq!(suggestion("pushtransform"), Some("pushTransform"));
+        assert_eq!(suggestion("sphre"), Some("sphere"));
+        assert_eq!(suggestion("xyzzyq"), None);
+    }
+
+    #[test]
+    fn every_command_is_documented() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
+        let docs = std::fs::read_to_string(path).unwrap();
+        let missing: Vec<&str> = command_names()
+            .filter(|c| !docs.contains(&format!("`{c}`")))
+            .collect();
+        assert!(missing.is_empty(), "not in docs/scene-format.md: {missing:?}");
+    }
+}

@@ -1,0 +1,94 @@
+//! Lines and tokens (docs/scene-format.md, "Lexical rules"): one command per line, tokens
+//! separated by spaces or tabs, `#` starting a comment, `\n` or `\r\n` line ends, text
+//! only.
+
+/// A token and its 1-based column (in characters).
+#[derive(Clone, Copy)]
+pub(super) struct Token<'a> {
+    pub text: &'a str,
+    pub col: u32,
+}
+
+/// One command: its name, its arguments and where it stands.
+pub(super) struct Command<'a> {
+    pub name: Token<'a>,
+    pub args: Vec<Token<'a>>,
+    pub line: u32,
+    /// Column just past the last token (where a missing argument would go).
+    pub end_col: u32,
+}
+
+/// Why a line is not text: the column of the first bad character and the message.
+pub(super) struct NotText {
+    pub col: u32,
+    pub message: String,
+}
+
+/// The lines of a file, without their terminators (a final line end adds no line).
+pub(super) fn split_lines(bytes: &[u8]) -> Vec<&[u8]> {
+    if bytes.is_empty() {
+        return Vec::new();
+    }
+    let body = bytes.strip_suffix(b"\n").unwrap_or(bytes);
+    body.split(|&b| b == b'\n')
+        .map(|l| l.strip_suffix(b"\r").unwrap_or(l))
+        .collect()
+}
+
+/// The command on line `line` (1-based), `None` for a blank or comment line.
+pub(super) fn command(line: u32, raw: &[u8]) -> Result<Option<Command<'_>>, NotText> {
+    let text = match std::str::from_utf8(raw) {
+        Ok(t) => t,
+        Err(e) => {
+            let col = String::from_utf8_lossy(&raw[..e.valid_up_to()]).chars().count() as u32 + 1;
+            let byte = raw[e.valid_up_to()];
+            return Err(NotText {
+                col,
+                message: format!("invalid UTF-8 (byte 0x{byte:02X}): scene files are text"),
+            });
+        }
+    };
+    if let Some((i, c)) = text.chars().enumerate().find(|(_, c)| c.is_control() && *c != '\t') {
+        return Err(NotText {
+            col: i as u32 + 1,
+            message: format!("unexpected control character U+{:04X}: scene files are text", c as u32),
+        });
+    }
+    let mut tokens = Vec::new();
+    let mut col = 0u32;
+    let mut start: Option<(usize, u32)> = None;
+    for (i, c) in text.char_indices() {
+        col += 1;
+        let blank = c == ' ' || c == '\t';
+        match (blank, start) {
+            (false, None) => start = Some((i, col)),
+            (true, Some((s, sc))) => {
+                tokens.push(Token {
+                    text: &text[s..i],
+                    col: sc,
+                });
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some((s, sc)) = start {
+        tokens.push(Token {
+            text: &text[s..],
+            col: sc,
+        });
+    }
+    // A token starting with '#' begins a comment to the end of the line.
+    if let Some(k) = tokens.iter().position(|t| t.text.starts_with('#')) {
+        tokens.truncate(k);
+    }
+    let Some((&name, args)) = tokens.split_first() else {
+        return Ok(None);
+    };
+    Ok(Some(Command {
+        name,
+        args: args.to_vec(),
+        line,
+        end_col: col + 1,
+    }))
+}

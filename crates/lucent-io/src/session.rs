@@ -1,0 +1,126 @@
+//! The start-up sequence every entry point runs — the `render`, `check` and `bench`
+//! commands and the tests: parse a scene file, build it, and render a job of it on a
+//! pool of worker threads with a progress callback and a cancel flag.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use lucent_core::accel::AccelKind;
+use lucent_core::film::Film;
+use lucent_core::render::job::RenderJob;
+use lucent_core::render::{render, RenderControl, RenderStats};
+
+use crate::build::{build, BuildOptions, Built};
+use crate::cse167::{parse_bytes, parse_file, ParseOptions};
+use crate::desc::SceneDesc;
+use crate::diag::Diagnostics;
+
+#[derive(Clone, Copy, Debug)]
+pub struct SessionOptions {
+    /// Unknown commands are errors instead of warnings.
+    pub strict: bool,
+    pub accel: AccelKind,
+}
+
+impl Default for SessionOptions {
+    fn default() -> Self {
+        SessionOptions {
+            strict: false,
+            accel: AccelKind::Bvh,
+        }
+    }
+}
+
+/// A scene on its way to being rendered: what the file said, everything reported about
+/// it so far, and — once built without errors — the scene itself.
+pub struct Session {
+    pub desc: SceneDesc,
+    pub diags: Diagnostics,
+    pub built: Option<Built>,
+    pub parse_seconds: f64,
+    pub build_seconds: f64,
+    options: SessionOptions,
+}
+
+impl Session {
+    /// Parses a scene file; nothing is built yet ([`Session::build`]).
+    pub fn parse_file(path: &Path, options: SessionOptions) -> Session {
+        Session::parse_with(options, || parse_file(path, ParseOptions { strict: options.strict }))
+    }
+
+    /// Parses scene text; `name` is what diagnostics call it, and the files it names are
+    /// found beside it.
+    pub fn parse_text(name: &str, text: &[u8], options: SessionOptions) -> Session {
+        Session::parse_with(options, || {
+            parse_bytes(name, text, ParseOptions { strict: options.strict })
+        })
+    }
+
+    fn parse_with(options: SessionOptions, parse: impl FnOnce() -> (SceneDesc, Diagnostics)) -> Session {
+        let start = Instant::now();
+        let (desc, diags) = parse();
+        Session {
+            desc,
+            diags,
+            built: None,
+            parse_seconds: start.elapsed().as_secs_f64(),
+            build_seconds: 0.0,
+            options,
+        }
+    }
+
+    /// Parses and builds a scene file.
+    pub fn open(path: &Path, options: SessionOptions) -> Session {
+        let mut s = Session::parse_file(path, options);
+        s.build();
+        s
+    }
+
+    /// Builds what was parsed, unless the parse found errors; whether the scene is ready.
+    pub fn build(&mut self) -> bool {
+        if self.built.is_none() && !self.diags.has_errors() {
+            let start = Instant::now();
+            let options = BuildOptions {
+                accel: self.options.accel,
+            };
+            self.built = build(&self.desc, &options, &mut self.diags);
+            self.build_seconds = start.elapsed().as_secs_f64();
+        }
+        self.built.is_some()
+    }
+}
+
+/// Worker threads that render jobs.
+pub struct Renderer {
+    pool: rayon::ThreadPool,
+}
+
+impl Renderer {
+    /// `threads` workers, or one per core.
+    pub fn new(threads: Option<usize>) -> Result<Renderer, String> {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads.unwrap_or(0))
+            .build()
+            .map(|pool| Renderer { pool })
+            .map_err(|e| format!("cannot start worker threads: {e}"))
+    }
+
+    pub fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
+    /// Renders `job` of a built scene; `progress` hears of every finished tile's pixels,
+    /// and setting `cancel` stops the render (`None`).
+    pub fn render(
+        &self,
+        built: &Built,
+        job: &RenderJob,
+        progress: &(dyn Fn(u64) + Sync),
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RenderStats)> {
+        let control = RenderControl { progress, cancel };
+        self.pool
+            .install(|| render(&built.scene, built.integrator.as_ref(), job, &control))
+    }
+}
