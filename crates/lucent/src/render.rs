@@ -69,12 +69,9 @@ pub fn run(args: &RenderArgs) -> u8 {
         return EXIT_BAD_INPUT;
     };
 
-    let renderer = match Renderer::new(args.threads.map(|n| n as usize)) {
+    let renderer = match start_renderer(args.threads) {
         Ok(r) => r,
-        Err(e) => {
-            eprintln!("lucent: error: {e}");
-            return 1;
-        }
+        Err(code) => return code,
     };
     let job = built.job();
     let progress = Progress::new(job.pixels.pixels(), args.quiet);
@@ -126,4 +123,13 @@ pub fn run(args: &RenderArgs) -> u8 {
         );
     }
     0
+}
+
+/// Worker threads for `--threads N` (all cores without it), or the exit code after
+/// saying why they could not start.
+pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
+    Renderer::new(threads.map(|n| n as usize)).map_err(|e| {
+        eprintln!("lucent: error: {e}");
+        1
+    })
 }

@@ -217,12 +217,12 @@ fn world_mesh(mesh: &TriangleMesh, t: &Transform, material: u32) -> TriangleMesh
 /// The core's surface of a description (control points weighted: `(w·x, w·y, w·z, w)`).
 fn nurbs_surface(n: &NurbsDesc) -> NurbsSurface {
     NurbsSurface {
-        degree_u: n.degree_u,
-        degree_v: n.degree_v,
-        count_u: n.count_u,
-        count_v: n.count_v,
-        knots_u: n.knots_u.clone(),
-        knots_v: n.knots_v.clone(),
+        degree_u: n.u.degree,
+        degree_v: n.v.degree,
+        count_u: n.u.count,
+        count_v: n.v.count,
+        knots_u: n.u.knots.clone(),
+        knots_v: n.v.knots.clone(),
         points: n
             .points
             .iter()

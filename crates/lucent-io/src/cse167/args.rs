@@ -1,6 +1,8 @@
 //! Reading a command's arguments: counts, numbers (C-style decimals within the `f32`
 //! range), integers, keywords and colours, each bad one reported at its place.
 
+use std::ops::RangeInclusive;
+
 use glam::DVec3;
 
 use super::lexer::{Command, Token};
@@ -176,6 +178,46 @@ impl Parser {
             );
         }
         DVec3::new(v[0], v[1], v[2])
+    }
+
+    /// Whether integer argument `k` (whose value is `x`) lies in `range`; an error if not.
+    pub fn in_range(&mut self, c: &Command, k: usize, x: i64, range: RangeInclusive<i64>, what: &str) -> bool {
+        if range.contains(&x) {
+            return true;
+        }
+        let msg = format!(
+            "{}: {what} must be between {} and {}, got {x}",
+            c.name.text,
+            range.start(),
+            range.end()
+        );
+        self.err_arg(c, k, msg);
+        false
+    }
+
+    /// Whether `c` has one or two arguments (`what` says which); an error if not.
+    pub fn one_or_two(&mut self, c: &Command, what: &str) -> bool {
+        let n = c.args.len();
+        if (1..=2).contains(&n) {
+            return true;
+        }
+        self.err_cmd(c, format!("{}: expected {what}, got {n} arguments", c.name.text));
+        false
+    }
+
+    /// The optional second argument read by `read` (which reports what is wrong with it),
+    /// or `default` when there is none.
+    pub fn optional_second<T>(
+        &mut self,
+        c: &Command,
+        default: T,
+        read: impl FnOnce(&mut Self, &Command) -> Option<T>,
+    ) -> Option<T> {
+        if c.args.len() < 2 {
+            Some(default)
+        } else {
+            read(self, c)
+        }
     }
 
     /// Whether the arguments are the single word `off` (`glossy off`, `bumpmap off`, …).

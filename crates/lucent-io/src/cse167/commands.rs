@@ -161,9 +161,7 @@ mod tests {
     fn every_command_is_documented() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
         let docs = std::fs::read_to_string(path).unwrap();
-        let missing: Vec<&str> = command_names()
-            .filter(|c| !docs.contains(&format!("`{c}`")))
-            .collect();
+        let missing: Vec<&str> = command_names().filter(|c| !docs.contains(&format!("`{c}`"))).collect();
         assert!(missing.is_empty(), "not in docs/scene-format.md: {missing:?}");
     }
 }

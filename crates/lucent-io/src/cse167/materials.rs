@@ -68,12 +68,7 @@ impl Parser {
             );
             return;
         }
-        if !(1..=MAX_GLOSSY_SAMPLES).contains(&samples) {
-            self.err_arg(
-                c,
-                1,
-                format!("glossy: samples must be between 1 and {MAX_GLOSSY_SAMPLES}, got {samples}"),
-            );
+        if !self.in_range(c, 1, samples, 1..=MAX_GLOSSY_SAMPLES, "samples") {
             return;
         }
         let glossy = GlossyDesc {

@@ -7,7 +7,7 @@ use glam::DVec4;
 
 use super::lexer::Command;
 use super::parser::Parser;
-use crate::desc::{NurbsDesc, SurfaceRecipe};
+use crate::desc::{NurbsDesc, NurbsDirection, SurfaceRecipe};
 use crate::diag::Loc;
 
 /// Degrees `nurbs` accepts.
@@ -30,12 +30,7 @@ impl Parser {
             return;
         };
         for (k, d) in [(0, du), (1, dv)] {
-            if !(1..=MAX_DEGREE).contains(&d) {
-                self.err_arg(
-                    c,
-                    k,
-                    format!("nurbs: degree must be between 1 and {MAX_DEGREE}, got {d}"),
-                );
+            if !self.in_range(c, k, d, 1..=MAX_DEGREE, "degree") {
                 return;
             }
         }
@@ -56,23 +51,29 @@ impl Parser {
         self.nurbs = Some(PendingNurbs {
             at: self.loc(c.line, &c.name),
             surface: NurbsDesc {
-                degree_u: du as usize,
-                degree_v: dv as usize,
-                count_u: nu as usize,
-                count_v: nv as usize,
-                ..NurbsDesc::default()
+                u: NurbsDirection {
+                    degree: du as usize,
+                    count: nu as usize,
+                    knots: Vec::new(),
+                },
+                v: NurbsDirection {
+                    degree: dv as usize,
+                    count: nv as usize,
+                    knots: Vec::new(),
+                },
+                points: Vec::new(),
             },
         });
     }
 
     /// What the pending surface needs next.
     fn nurbs_expects(s: &NurbsDesc) -> String {
-        if s.knots_u.is_empty() {
+        if s.u.knots.is_empty() {
             "knotsu".into()
-        } else if s.knots_v.is_empty() {
+        } else if s.v.knots.is_empty() {
             "knotsv".into()
         } else {
-            format!("{} more cpoint lines", s.count_u * s.count_v - s.points.len())
+            format!("{} more cpoint lines", s.u.count * s.v.count - s.points.len())
         }
     }
 
@@ -111,9 +112,9 @@ impl Parser {
         };
         let expected = Self::nurbs_expects(&p.surface);
         let fits = match name {
-            "knotsu" => p.surface.knots_u.is_empty(),
-            "knotsv" => !p.surface.knots_u.is_empty() && p.surface.knots_v.is_empty(),
-            _ => !p.surface.knots_v.is_empty(),
+            "knotsu" => p.surface.u.knots.is_empty(),
+            "knotsv" => !p.surface.u.knots.is_empty() && p.surface.v.knots.is_empty(),
+            _ => !p.surface.v.knots.is_empty(),
         };
         if !fits {
             self.err_cmd(
@@ -134,14 +135,11 @@ impl Parser {
             }
             s.points.push(DVec4::new(x, y, z, w));
         } else {
-            let Some(knots) = self.knots(c, s) else { return };
-            if name == "knotsu" {
-                s.knots_u = knots;
-            } else {
-                s.knots_v = knots;
-            }
+            let direction = if name == "knotsu" { &mut s.u } else { &mut s.v };
+            let Some(knots) = self.knots(c, direction) else { return };
+            direction.knots = knots;
         }
-        if s.points.len() == s.count_u * s.count_v {
+        if s.points.len() == s.u.count * s.v.count {
             self.surface_at(p.at, SurfaceRecipe::Nurbs(p.surface));
         } else {
             self.nurbs = Some(p);
@@ -150,13 +148,9 @@ impl Parser {
 
     /// The knot vector of a `knotsu` or `knotsv` line: count + degree + 1 values that
     /// never decrease and leave a parameter range.
-    fn knots(&mut self, c: &Command, s: &NurbsDesc) -> Option<Vec<f64>> {
+    fn knots(&mut self, c: &Command, direction: &NurbsDirection) -> Option<Vec<f64>> {
         let name = c.name.text;
-        let (degree, count) = if name == "knotsu" {
-            (s.degree_u, s.count_u)
-        } else {
-            (s.degree_v, s.count_v)
-        };
+        let (degree, count) = (direction.degree, direction.count);
         let want = count + degree + 1;
         if c.args.len() != want {
             self.err_cmd(

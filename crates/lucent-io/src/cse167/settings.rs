@@ -6,7 +6,7 @@
 use super::lexer::Command;
 use super::parser::Parser;
 use super::MAX_PIXELS;
-use crate::desc::{DirectionSampling, IntegratorKind, Located, NeeMode};
+use crate::desc::{DirectionSampling, IntegratorKind, Located, NeeMode, SceneDesc};
 
 impl Parser {
     /// `size width height`.
@@ -82,13 +82,7 @@ impl Parser {
 
     /// `integrator raytracer|analyticdirect|direct|pathtracer`.
     pub(super) fn integrator(&mut self, c: &Command) {
-        if let Some(k) = self.keyword(c, &IntegratorKind::ALL) {
-            let v = Located {
-                value: k,
-                loc: self.loc(c.line, &c.args[0]),
-            };
-            self.set_global(c, |d| &mut d.integrator, v);
-        }
+        self.keyword_setting(c, &IntegratorKind::ALL, |d| &mut d.integrator);
     }
 
     /// `spp n` and `lightsamples n`: counts ≥ 1.
@@ -113,29 +107,18 @@ impl Parser {
 
     /// `lightstratify on|off` and `russianroulette on|off`.
     pub(super) fn switch(&mut self, c: &Command) {
-        if let Some(on) = self.keyword(c, &[("on", true), ("off", false)]) {
-            let v = Located {
-                value: on,
-                loc: self.loc(c.line, &c.args[0]),
-            };
-            if c.name.text == "lightstratify" {
-                self.set_global(c, |d| &mut d.light_stratify, v);
-            } else {
-                self.set_global(c, |d| &mut d.russian_roulette, v);
-            }
+        let on_off = [("on", true), ("off", false)];
+        if c.name.text == "lightstratify" {
+            self.keyword_setting(c, &on_off, |d| &mut d.light_stratify);
+        } else {
+            self.keyword_setting(c, &on_off, |d| &mut d.russian_roulette);
         }
     }
 
     /// `nexteventestimation on|off|mis`.
     pub(super) fn next_event_estimation(&mut self, c: &Command) {
         let modes = [("on", NeeMode::On), ("off", NeeMode::Off), ("mis", NeeMode::Mis)];
-        if let Some(m) = self.keyword(c, &modes) {
-            let v = Located {
-                value: m,
-                loc: self.loc(c.line, &c.args[0]),
-            };
-            self.set_global(c, |d| &mut d.next_event_estimation, v);
-        }
+        self.keyword_setting(c, &modes, |d| &mut d.next_event_estimation);
     }
 
     /// `importancesampling hemisphere|cosine|brdf`.
@@ -145,12 +128,19 @@ impl Parser {
             ("cosine", DirectionSampling::Cosine),
             ("brdf", DirectionSampling::Brdf),
         ];
-        if let Some(m) = self.keyword(c, &kinds) {
-            let v = Located {
-                value: m,
-                loc: self.loc(c.line, &c.args[0]),
-            };
-            self.set_global(c, |d| &mut d.importance_sampling, v);
+        self.keyword_setting(c, &kinds, |d| &mut d.importance_sampling);
+    }
+
+    /// A global setting given as one of the names in `options`, located at its value.
+    fn keyword_setting<T: Copy>(
+        &mut self,
+        c: &Command,
+        options: &[(&str, T)],
+        field: impl Fn(&mut SceneDesc) -> &mut Option<Located<T>>,
+    ) {
+        if let Some(value) = self.keyword(c, options) {
+            let loc = self.loc(c.line, &c.args[0]);
+            self.set_global(c, field, Located { value, loc });
         }
     }
 }

@@ -41,12 +41,7 @@ impl Parser {
         let Some(levels) = self.integer(c, &c.args[1]) else {
             return;
         };
-        if !(0..=MAX_SUBDIVISION_LEVEL).contains(&levels) {
-            self.err_arg(
-                c,
-                1,
-                format!("subdivmesh: levels must be between 0 and {MAX_SUBDIVISION_LEVEL}, got {levels}"),
-            );
+        if !self.in_range(c, 1, levels, 0..=MAX_SUBDIVISION_LEVEL, "levels") {
             return;
         }
         let levels = Located {
@@ -59,28 +54,15 @@ impl Parser {
 
     /// `bezierpatches file [divisions]`: each patch becomes `divisions × divisions` quads.
     pub(super) fn bezier_patches(&mut self, c: &Command) {
-        if c.args.is_empty() || c.args.len() > 2 {
-            let n = c.args.len();
-            self.err_cmd(
-                c,
-                format!("bezierpatches: expected a file name and optionally a number of divisions, got {n} arguments"),
-            );
+        if !self.one_or_two(c, "a file name and optionally a number of divisions") {
             return;
         }
-        let divisions = match c.args.get(1) {
-            None => 16,
-            Some(tok) => match self.integer(c, tok) {
-                Some(d) if (1..=MAX_PATCH_DIVISIONS).contains(&d) => d as u32,
-                Some(d) => {
-                    self.err_arg(
-                        c,
-                        1,
-                        format!("bezierpatches: divisions must be between 1 and {MAX_PATCH_DIVISIONS}, got {d}"),
-                    );
-                    return;
-                }
-                None => return,
-            },
+        let Some(divisions) = self.optional_second(c, 16, |p, c| {
+            let d = p.integer(c, &c.args[1])?;
+            p.in_range(c, 1, d, 1..=MAX_PATCH_DIVISIONS, "divisions")
+                .then_some(d as u32)
+        }) else {
+            return;
         };
         let file = self.file_arg(c, 0);
         self.surface(c, SurfaceRecipe::BezierPatches { file, divisions });

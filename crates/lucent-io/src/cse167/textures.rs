@@ -120,28 +120,19 @@ impl Parser {
 
     /// `envmap file [intensity]`.
     pub(super) fn environment(&mut self, c: &Command) {
-        if c.args.is_empty() || c.args.len() > 2 {
-            let n = c.args.len();
-            self.err_cmd(
-                c,
-                format!("envmap: expected an image file and optionally an intensity, got {n} arguments"),
-            );
+        if !self.one_or_two(c, "an image file and optionally an intensity") {
             return;
         }
-        let intensity = match c.args.get(1) {
-            None => 1.0,
-            Some(tok) => match self.number(c, tok) {
-                Some(i) if i >= 0.0 => i,
-                Some(_) => {
-                    self.err_arg(
-                        c,
-                        1,
-                        format!("envmap: the intensity must not be negative, got {}", tok.text),
-                    );
-                    return;
-                }
-                None => return,
-            },
+        let Some(intensity) = self.optional_second(c, 1.0, |p, c| {
+            let i = p.number(c, &c.args[1])?;
+            if i >= 0.0 {
+                return Some(i);
+            }
+            let msg = format!("envmap: the intensity must not be negative, got {}", c.args[1].text);
+            p.err_arg(c, 1, msg);
+            None
+        }) else {
+            return;
         };
         let v = Located {
             value: EnvironmentDesc {

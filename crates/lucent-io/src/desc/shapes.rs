@@ -93,17 +93,23 @@ pub enum SubdivisionScheme {
     CatmullClark,
 }
 
-/// A NURBS surface as written: degrees, control point counts, knot vectors and the
-/// control points `(x, y, z, w)` with u varying fastest.
+/// A NURBS surface as written: its degree, control point count and knot vector in each
+/// parameter direction, and the control points `(x, y, z, w)` with u varying fastest.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct NurbsDesc {
-    pub degree_u: usize,
-    pub degree_v: usize,
-    pub count_u: usize,
-    pub count_v: usize,
-    pub knots_u: Vec<f64>,
-    pub knots_v: Vec<f64>,
+    pub u: NurbsDirection,
+    pub v: NurbsDirection,
     pub points: Vec<DVec4>,
+}
+
+/// One parameter direction of a NURBS surface.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct NurbsDirection {
+    pub degree: usize,
+    /// Control points along this direction.
+    pub count: usize,
+    /// `count + degree + 1` values (empty until the `knotsu` or `knotsv` line).
+    pub knots: Vec<f64>,
 }
 
 /// `displacementmap name scale`.

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
-use lucent_io::session::{Renderer, Session, SessionOptions};
+use lucent_io::session::{Session, SessionOptions};
 
 use crate::output::report;
 use crate::EXIT_BAD_INPUT;
@@ -37,12 +37,9 @@ pub fn run(args: &SceneBenchArgs) -> u8 {
     };
     let (parse_s, build_s) = (session.parse_seconds, session.build_seconds);
 
-    let renderer = match Renderer::new(args.threads.map(|n| n as usize)) {
+    let renderer = match crate::render::start_renderer(args.threads) {
         Ok(r) => r,
-        Err(e) => {
-            eprintln!("lucent: error: {e}");
-            return 1;
-        }
+        Err(code) => return code,
     };
     let job = built.job();
     let cancel = AtomicBool::new(false);

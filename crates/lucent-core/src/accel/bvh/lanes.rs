@@ -104,110 +104,74 @@ mod x86 {
     use super::{FusedLanes, Lanes};
     use std::arch::x86_64::*;
 
-    /// Four lanes (SSE, part of every x86-64).
-    #[derive(Clone, Copy)]
-    pub struct Sse(__m128);
+    /// A [`Lanes`] type over an x86 vector, from the intrinsic of each operation.
+    macro_rules! x86_lanes {
+        (
+            $(#[$doc:meta])* $name:ident($vector:ty, $n:literal):
+            splat $splat:expr, load $load:expr, store $store:expr,
+            [$($op:ident $op_fn:expr),+],
+            le $le:expr, and $and:expr, all $all:expr, bits $bits:expr
+        ) => {
+            $(#[$doc])*
+            #[derive(Clone, Copy)]
+            pub struct $name($vector);
 
-    impl Lanes for Sse {
-        const N: usize = 4;
-        type Mask = __m128;
-        #[inline(always)]
-        unsafe fn splat(x: f32) -> Sse {
-            Sse(_mm_set1_ps(x))
-        }
-        #[inline(always)]
-        unsafe fn load(p: *const f32) -> Sse {
-            Sse(_mm_load_ps(p))
-        }
-        #[inline(always)]
-        unsafe fn store(self, p: *mut f32) {
-            _mm_storeu_ps(p, self.0)
-        }
-        #[inline(always)]
-        unsafe fn sub(self, other: Sse) -> Sse {
-            Sse(_mm_sub_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn mul(self, other: Sse) -> Sse {
-            Sse(_mm_mul_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn max(self, other: Sse) -> Sse {
-            Sse(_mm_max_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn min(self, other: Sse) -> Sse {
-            Sse(_mm_min_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn le(self, other: Sse) -> __m128 {
-            _mm_cmple_ps(self.0, other.0)
-        }
-        #[inline(always)]
-        unsafe fn and(a: __m128, b: __m128) -> __m128 {
-            _mm_and_ps(a, b)
-        }
-        #[inline(always)]
-        unsafe fn all() -> __m128 {
-            _mm_castsi128_ps(_mm_set1_epi32(-1))
-        }
-        #[inline(always)]
-        unsafe fn bits(m: __m128) -> u32 {
-            _mm_movemask_ps(m) as u32
-        }
+            impl Lanes for $name {
+                const N: usize = $n;
+                type Mask = $vector;
+                #[inline(always)]
+                unsafe fn splat(x: f32) -> $name {
+                    $name($splat(x))
+                }
+                #[inline(always)]
+                unsafe fn load(p: *const f32) -> $name {
+                    $name($load(p))
+                }
+                #[inline(always)]
+                unsafe fn store(self, p: *mut f32) {
+                    $store(p, self.0)
+                }
+                $(
+                    #[inline(always)]
+                    unsafe fn $op(self, other: $name) -> $name {
+                        $name($op_fn(self.0, other.0))
+                    }
+                )+
+                #[inline(always)]
+                unsafe fn le(self, other: $name) -> $vector {
+                    $le(self.0, other.0)
+                }
+                #[inline(always)]
+                unsafe fn and(a: $vector, b: $vector) -> $vector {
+                    $and(a, b)
+                }
+                #[inline(always)]
+                unsafe fn all() -> $vector {
+                    $all
+                }
+                #[inline(always)]
+                unsafe fn bits(m: $vector) -> u32 {
+                    $bits(m) as u32
+                }
+            }
+        };
     }
 
-    /// Eight lanes (AVX; the fused form needs FMA, which every AVX2 CPU has).
-    #[derive(Clone, Copy)]
-    pub struct Avx(__m256);
+    x86_lanes! {
+        /// Four lanes (SSE, part of every x86-64).
+        Sse(__m128, 4):
+        splat _mm_set1_ps, load _mm_load_ps, store _mm_storeu_ps,
+        [sub _mm_sub_ps, mul _mm_mul_ps, max _mm_max_ps, min _mm_min_ps],
+        le _mm_cmple_ps, and _mm_and_ps, all _mm_castsi128_ps(_mm_set1_epi32(-1)), bits _mm_movemask_ps
+    }
 
-    impl Lanes for Avx {
-        const N: usize = 8;
-        type Mask = __m256;
-        #[inline(always)]
-        unsafe fn splat(x: f32) -> Avx {
-            Avx(_mm256_set1_ps(x))
-        }
-        #[inline(always)]
-        unsafe fn load(p: *const f32) -> Avx {
-            Avx(_mm256_load_ps(p))
-        }
-        #[inline(always)]
-        unsafe fn store(self, p: *mut f32) {
-            _mm256_storeu_ps(p, self.0)
-        }
-        #[inline(always)]
-        unsafe fn sub(self, other: Avx) -> Avx {
-            Avx(_mm256_sub_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn mul(self, other: Avx) -> Avx {
-            Avx(_mm256_mul_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn max(self, other: Avx) -> Avx {
-            Avx(_mm256_max_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn min(self, other: Avx) -> Avx {
-            Avx(_mm256_min_ps(self.0, other.0))
-        }
-        #[inline(always)]
-        unsafe fn le(self, other: Avx) -> __m256 {
-            _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, other.0)
-        }
-        #[inline(always)]
-        unsafe fn and(a: __m256, b: __m256) -> __m256 {
-            _mm256_and_ps(a, b)
-        }
-        #[inline(always)]
-        unsafe fn all() -> __m256 {
-            _mm256_castsi256_ps(_mm256_set1_epi32(-1))
-        }
-        #[inline(always)]
-        unsafe fn bits(m: __m256) -> u32 {
-            _mm256_movemask_ps(m) as u32
-        }
+    x86_lanes! {
+        /// Eight lanes (AVX; the fused form needs FMA, which every AVX2 CPU has).
+        Avx(__m256, 8):
+        splat _mm256_set1_ps, load _mm256_load_ps, store _mm256_storeu_ps,
+        [sub _mm256_sub_ps, mul _mm256_mul_ps, max _mm256_max_ps, min _mm256_min_ps],
+        le _mm256_cmp_ps::<_CMP_LE_OQ>, and _mm256_and_ps,
+        all _mm256_castsi256_ps(_mm256_set1_epi32(-1)), bits _mm256_movemask_ps
     }
 
     impl FusedLanes for Avx {

@@ -128,122 +128,147 @@ impl FmaOffsets {
     }
 }
 
-/// Which child boxes a ray enters before `t_max`, and where.
+/// Which child boxes a ray enters before `t_max`, and where: one group of `L::N` boxes at
+/// a time.
 pub trait BoxTest {
     /// The ray in the form the test wants it (lanes of broadcast constants), made once
     /// per ray by the type's own `prepare`.
     type Ray;
-    /// `ZERO`: the ray has direction components that are zero.
-    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32;
+    type Lanes: Lanes;
+
+    /// The boxes in slots `first .. first + N`: their entry distances, and which of them
+    /// the ray enters. `ZERO`: the ray has direction components that are zero.
+    unsafe fn group<const ZERO: bool>(
+        node: &WideNode,
+        r: &Self::Ray,
+        t_max: f32,
+        first: usize,
+    ) -> (Self::Lanes, <Self::Lanes as Lanes>::Mask);
+
+    /// All of the node's boxes: the entry distances are stored in `dist`, the entered
+    /// boxes are the returned mask's bits.
+    #[inline(always)]
+    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+        let mut mask = 0;
+        for first in (0..WIDTH).step_by(Self::Lanes::N) {
+            let (near, enters) = Self::group::<ZERO>(node, r, t_max, first);
+            near.store(dist.as_mut_ptr().add(first));
+            mask |= Self::Lanes::bits(enters) << first;
+        }
+        mask
+    }
 }
 
-/// The slab test over lanes `L`: `(plane − origin) · (1/d)` per plane, the far distance
-/// with the widened reciprocal; axes the ray does not move along are decided by where
-/// the origin lies. The node's eight boxes take `WIDTH / L::N` steps.
-pub struct Slab<L>(PhantomData<L>);
+/// The lanes of row `offset` (bytes, see [`RayBoxes`]) of a node, from slot `first`.
+#[inline(always)]
+unsafe fn row<L: Lanes>(node: &WideNode, offset: usize, first: usize) -> L {
+    L::load(row_ptr(node, offset, first))
+}
 
-/// The ray as lanes of broadcast constants (see [`Slab`]).
+/// A ray's box-test constants as lanes of broadcasts: per axis, the multiplier and the
+/// offset that turn a near plane and a far plane into distances.
 #[derive(Clone, Copy)]
-pub struct SlabRay<L> {
-    origin: [L; 3],
-    inv_dir: [L; 3],
-    inv_far: [L; 3],
+pub struct PlaneLanes<L> {
+    near_mul: [L; 3],
+    near_off: [L; 3],
+    far_mul: [L; 3],
+    far_off: [L; 3],
     t_min: L,
     rb: RayBoxes,
 }
 
-impl<L: Lanes> Slab<L> {
+impl<L: Lanes> PlaneLanes<L> {
     #[inline(always)]
-    pub unsafe fn prepare(r: &RayBoxes) -> SlabRay<L> {
-        SlabRay {
-            origin: r.origin.map(|x| L::splat(x)),
-            inv_dir: r.inv_dir.map(|x| L::splat(x)),
-            inv_far: r.inv_far.map(|x| L::splat(x)),
+    unsafe fn new(r: &RayBoxes, [near_mul, near_off, far_mul, far_off]: [[f32; 3]; 4]) -> PlaneLanes<L> {
+        let splat = |v: [f32; 3]| v.map(|x| L::splat(x));
+        PlaneLanes {
+            near_mul: splat(near_mul),
+            near_off: splat(near_off),
+            far_mul: splat(far_mul),
+            far_off: splat(far_off),
             t_min: L::splat(r.t_min),
             rb: *r,
         }
     }
 }
 
-impl<L: Lanes> BoxTest for Slab<L> {
-    type Ray = SlabRay<L>;
+/// The slab test over lanes `L`, with planes made into distances by `D`: the entry
+/// distance is the largest near-plane distance (and `t_min`), the exit distance the
+/// smallest far-plane distance (and the search limit); axes the ray does not move along
+/// are decided by where the origin lies.
+pub struct Planes<L, D>(PhantomData<(L, D)>);
+
+/// How a plane coordinate becomes a distance along the ray, given the axis's multiplier
+/// and offset ([`PlaneLanes`]).
+pub trait Distance<L: Lanes> {
+    unsafe fn distance(plane: L, mul: L, off: L) -> L;
+}
+
+/// `(plane − origin) · (1/d)`: the far reciprocal widened by `1 + 2γ(3)`.
+pub struct Subtract;
+
+impl<L: Lanes> Distance<L> for Subtract {
     #[inline(always)]
-    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &SlabRay<L>, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
-        let rb = &r.rb;
-        let mut mask = 0;
-        for first in (0..WIDTH).step_by(L::N) {
-            let row = |offset: usize| L::load(row_ptr(node, offset, first));
-            let mut near = r.t_min;
-            let mut far = L::splat(f32::INFINITY);
-            let mut inside = L::all();
-            for a in 0..3 {
-                let o = r.origin[a];
-                if ZERO && rb.zero[a] {
-                    let (lo, hi) = (row(a * ROW_BYTES), row((a + 3) * ROW_BYTES));
-                    inside = L::and(inside, L::and(lo.le(o), o.le(hi)));
-                } else {
-                    let n = row(rb.near_row[a]).sub(o).mul(r.inv_dir[a]);
-                    let f = row(rb.far_row[a]).sub(o).mul(r.inv_far[a]);
-                    near = n.max(near);
-                    far = f.min(far);
-                }
-            }
-            far = far.min(L::splat(t_max));
-            near.store(dist.as_mut_ptr().add(first));
-            mask |= L::bits(L::and(near.le(far), inside)) << first;
-        }
-        mask
+    unsafe fn distance(plane: L, mul: L, off: L) -> L {
+        plane.sub(off).mul(mul)
     }
 }
 
-/// The fused slab test over lanes `L` ([`FmaOffsets`]): one multiply–subtract per
-/// plane, `plane · (1/d) − o/d`; only for rays that have the offsets (no zero axes).
-pub struct Fused<L>(PhantomData<L>);
+/// `plane · (1/d) − o/d` in one fused multiply–subtract, with the offsets and widening of
+/// [`FmaOffsets`]; only for rays that have them (no zero axes).
+pub struct MulSub;
 
-/// The fused test's ray: reciprocals and offsets as lanes of broadcasts.
-#[derive(Clone, Copy)]
-pub struct FusedRay<L> {
-    inv_near: [L; 3],
-    near: [L; 3],
-    inv_far: [L; 3],
-    far: [L; 3],
-    t_min: L,
-    rb: RayBoxes,
+impl<L: FusedLanes> Distance<L> for MulSub {
+    #[inline(always)]
+    unsafe fn distance(plane: L, mul: L, off: L) -> L {
+        plane.mul_sub(mul, off)
+    }
+}
+
+/// The plain slab test.
+pub type Slab<L> = Planes<L, Subtract>;
+/// The fused slab test.
+pub type Fused<L> = Planes<L, MulSub>;
+
+impl<L: Lanes> Slab<L> {
+    #[inline(always)]
+    pub unsafe fn prepare(r: &RayBoxes) -> PlaneLanes<L> {
+        PlaneLanes::new(r, [r.inv_dir, r.origin, r.inv_far, r.origin])
+    }
 }
 
 impl<L: FusedLanes> Fused<L> {
     /// `offsets` must come from the same ray.
     #[inline(always)]
-    pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets) -> FusedRay<L> {
-        FusedRay {
-            inv_near: r.inv_dir.map(|x| L::splat(x)),
-            near: offsets.near.map(|x| L::splat(x)),
-            inv_far: offsets.inv_far.map(|x| L::splat(x)),
-            far: offsets.far.map(|x| L::splat(x)),
-            t_min: L::splat(r.t_min),
-            rb: *r,
-        }
+    pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets) -> PlaneLanes<L> {
+        PlaneLanes::new(r, [r.inv_dir, offsets.near, offsets.inv_far, offsets.far])
     }
 }
 
-impl<L: FusedLanes> BoxTest for Fused<L> {
-    type Ray = FusedRay<L>;
+impl<L: Lanes, D: Distance<L>> BoxTest for Planes<L, D> {
+    type Ray = PlaneLanes<L>;
+    type Lanes = L;
     #[inline(always)]
-    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &FusedRay<L>, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+    unsafe fn group<const ZERO: bool>(node: &WideNode, r: &PlaneLanes<L>, t_max: f32, first: usize) -> (L, L::Mask) {
         let rb = &r.rb;
-        let mut mask = 0;
-        for first in (0..WIDTH).step_by(L::N) {
-            let row = |offset: usize| L::load(row_ptr(node, offset, first));
-            let mut near = r.t_min;
-            let mut far = L::splat(t_max);
-            for a in 0..3 {
-                near = row(rb.near_row[a]).mul_sub(r.inv_near[a], r.near[a]).max(near);
-                far = row(rb.far_row[a]).mul_sub(r.inv_far[a], r.far[a]).min(far);
+        let mut near = r.t_min;
+        let mut far = L::splat(t_max);
+        let mut inside = L::all();
+        for a in 0..3 {
+            if ZERO && rb.zero[a] {
+                // The plain test's offset is the origin.
+                let o = r.near_off[a];
+                let lo = row::<L>(node, a * ROW_BYTES, first);
+                let hi = row::<L>(node, (a + 3) * ROW_BYTES, first);
+                inside = L::and(inside, L::and(lo.le(o), o.le(hi)));
+            } else {
+                let n = D::distance(row::<L>(node, rb.near_row[a], first), r.near_mul[a], r.near_off[a]);
+                let f = D::distance(row::<L>(node, rb.far_row[a], first), r.far_mul[a], r.far_off[a]);
+                near = n.max(near);
+                far = f.min(far);
             }
-            near.store(dist.as_mut_ptr().add(first));
-            mask |= L::bits(near.le(far)) << first;
         }
-        mask
+        (near, L::and(near.le(far), inside))
     }
 }
 
