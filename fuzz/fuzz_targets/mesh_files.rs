@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use lucent_core::shape::subdivision::{subdivide, Scheme};
+use lucent_core::tessellate::subdivision::{subdivide, Scheme};
 use lucent_io::mesh_file::{load_mesh, load_polygons};
 
 fuzz_target!(|data: &[u8]| {

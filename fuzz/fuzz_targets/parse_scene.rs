@@ -3,18 +3,15 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use lucent_io::build::{build, BuildOptions};
-use lucent_io::cse167::{parse_bytes, ParseOptions};
+use lucent_io::session::{Session, SessionOptions};
 
 fuzz_target!(|data: &[u8]| {
-    let (desc, mut diags) = parse_bytes("fuzz.test", data, ParseOptions::default());
-    if !diags.has_errors() {
-        if let Some((w, h)) = desc.size.as_ref().map(|s| s.value) {
-            // Building is linear in the scene; rendering is not exercised here.
-            if (w as u64) * (h as u64) <= 1 << 20 {
-                let _ = build(&desc, &BuildOptions::default(), &mut diags);
-            }
+    let mut session = Session::parse_text("fuzz.test", data, SessionOptions::default());
+    if let Some((w, h)) = session.desc.size.as_ref().map(|s| s.value) {
+        // Building is linear in the scene; rendering is not exercised here.
+        if (w as u64) * (h as u64) <= 1 << 20 {
+            session.build();
         }
     }
-    let _ = diags.render(&desc.sources);
+    let _ = session.diags.render(&session.desc.sources);
 });

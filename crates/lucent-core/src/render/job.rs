@@ -90,3 +90,36 @@ impl RenderJob {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jobs_outside_the_image_or_its_samples_are_refused() {
+        let resolution = Resolution { width: 40, height: 30 };
+        let whole = RenderJob::whole(resolution, 16);
+        assert!(whole.check().is_ok());
+        assert_eq!((whole.pixels.pixels(), whole.samples.len()), (1200, 16));
+        let mut crop = whole.clone();
+        crop.pixels = PixelRect {
+            x0: 10,
+            y0: 0,
+            x1: 41,
+            y1: 30,
+        };
+        assert!(crop.check().unwrap_err().contains("not a rectangle inside"));
+        crop.pixels = PixelRect {
+            x0: 10,
+            y0: 5,
+            x1: 10,
+            y1: 30,
+        };
+        assert!(crop.check().is_err(), "empty");
+        let mut samples = whole.clone();
+        samples.samples = 8..17;
+        assert!(samples.check().unwrap_err().contains("within 0..16"));
+        samples.samples = 3..3;
+        assert!(samples.check().is_err(), "empty");
+    }
+}

@@ -62,6 +62,27 @@ pub fn render_scene(
     (film, built.settings.gamma)
 }
 
+/// Renders the job the scene asks for, changed by `edit` (a crop, a sample range, a
+/// seed), with two worker threads; panics with the diagnostics on any error.
+pub fn render_job(
+    scene: &str,
+    text: &str,
+    edit: impl FnOnce(&mut lucent_core::render::job::RenderJob),
+) -> lucent_core::film::Film {
+    use lucent_io::session::{Renderer, Session, SessionOptions};
+    let mut session = Session::parse_text(scene, text.as_bytes(), SessionOptions::default());
+    session.build();
+    let built = session
+        .built
+        .as_ref()
+        .unwrap_or_else(|| panic!("{}", session.diags.render(&session.desc.sources)));
+    let mut job = built.job();
+    edit(&mut job);
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let renderer = Renderer::new(Some(2)).unwrap();
+    renderer.render(built, &job, &|_| {}, &cancel).unwrap().0
+}
+
 /// [`render_scene`] as 8-bit RGB.
 pub fn render_rgb8(scene: &str, text: &str, accel: lucent_core::accel::AccelKind, threads: usize) -> Vec<u8> {
     let (film, gamma) = render_scene(scene, text, accel, threads);
