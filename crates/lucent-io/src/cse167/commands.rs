@@ -3,6 +3,7 @@
 //! misspelt name, and lists the commands for the tests and the documentation check.
 
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::OnceLock;
 
 use super::lexer::Command;
@@ -91,9 +92,28 @@ pub fn command_names() -> impl Iterator<Item = &'static str> {
     COMMANDS.iter().map(|(name, _)| *name)
 }
 
-fn table() -> &'static HashMap<&'static str, Run> {
-    static TABLE: OnceLock<HashMap<&'static str, Run>> = OnceLock::new();
+/// The table by name. Looked up once per line, so it hashes with FNV-1a: a handful of
+/// instructions for a short name, where the default hasher costs several times that.
+fn table() -> &'static HashMap<&'static str, Run, BuildHasherDefault<Fnv>> {
+    static TABLE: OnceLock<HashMap<&'static str, Run, BuildHasherDefault<Fnv>>> = OnceLock::new();
     TABLE.get_or_init(|| COMMANDS.iter().copied().collect())
+}
+
+#[derive(Default)]
+struct Fnv(u64);
+
+impl Hasher for Fnv {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        let mut h = if self.0 == 0 { 0xcbf2_9ce4_8422_2325 } else { self.0 };
+        for &b in bytes {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+        self.0 = h;
+    }
 }
 
 impl Parser {
