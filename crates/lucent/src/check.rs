@@ -113,6 +113,11 @@ pub fn run(args: &CheckArgs) -> u8 {
         "sampling:   spp {spp}, lightsamples {samples}{}{lens}",
         if stratified { " (stratified)" } else { "" }
     );
+    let w = &built.work;
+    println!(
+        "work:       about {:.1e} rays ({:.0} per pixel), reflections up to depth {}",
+        w.rays, w.rays_per_pixel, w.depth
+    );
     println!(
         "textures:   {}{}",
         desc.textures.len(),

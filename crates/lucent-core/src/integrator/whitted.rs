@@ -1,5 +1,6 @@
 //! Scene commands: `integrator raytracer` (the default) and `maxdepth d` — the classic
-//! recursive ray tracer of CSE167 homework 3 (SCENE_FORMAT.md §4.3):
+//! recursive ray tracer of CSE167 homework 3 (docs/scene-format.md, "How a pixel is
+//! computed"):
 //!
 //! ```text
 //! I = A + E + Σ_lights V · (C / att) · (D · max(N·L, 0) + S · max(N·H, 0)^s)
@@ -11,7 +12,7 @@
 //! direction `R = d − 2 (d·N) N`. Normals are not flipped toward the viewer, and the
 //! specular term is not gated by `N·L`.
 //!
-//! lucent's extensions (EXTENSIONS.md):
+//! lucent's extensions:
 //! - a `quadLight` adds, for each of its `lightsamples` points (stratified with
 //!   `lightstratify on`), the same Blinn–Phong terms as a point light with `C` the
 //!   light's radiance times that point's share of the light's solid angle; its geometry
@@ -24,11 +25,16 @@
 //!   a Phong lobe around it (one ray below the first bounce, so that the count does not
 //!   grow geometrically), each weighted `S / samples`; rays that would leave below the
 //!   surface count as black.
+//!
+//! The ray tree is walked with an explicit stack, in the order of the recursion it
+//! stands for, so that no scene can overflow the thread's stack; a branch whose weight
+//! can no longer show is not traced (adaptive depth control, [`super::depth`]).
 
-use super::Integrator;
+use super::depth::DepthControl;
+use super::{Integrator, TraceCounts};
 use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::light::Light;
-use crate::math::Color;
+use crate::math::{Color, Vec3A};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
@@ -43,8 +49,33 @@ const MIN_WEIGHT: f32 = 1.0 / 2048.0;
 struct Tracing<'a> {
     scene: &'a Scene,
     sampler: &'a mut Sampler,
-    /// Every ray traced.
-    rays: &'a mut u64,
+    counts: &'a mut TraceCounts,
+}
+
+/// Branches of one ray tree waiting to be traced, at most this many at once (4 MB a
+/// thread); a branch beyond is cut and counted. Each level of a tree adds at most two, so
+/// only trees deeper than 32,768 bounces get here — where mirrors or glass reflect
+/// everything (no adaptive depth control) and `maxdepth` is larger than that.
+pub const MAX_PENDING: usize = 1 << 16;
+
+/// A branch of the ray tree waiting to be traced. The tree is walked depth first with an
+/// explicit stack — never by recursion, whose depth the scene would control — in the
+/// order a recursive tracer takes, so that every sample and every sum comes in the same
+/// order.
+enum Branch {
+    /// A ray (and the mirror chain after it, followed in a loop).
+    Ray { ray: Ray, depth: u32, weight: Color },
+    /// Glossy rays still to draw, `left` of them, around the mirror direction `mirror`
+    /// at `point`, each of weight `weight`, on the side `side` of the surface.
+    Glossy {
+        point: Vec3A,
+        mirror: Vec3A,
+        side: Vec3A,
+        exponent: f32,
+        left: u32,
+        depth: u32,
+        weight: Color,
+    },
 }
 
 pub struct Whitted {
@@ -54,6 +85,8 @@ pub struct Whitted {
     pub light_samples: u32,
     /// `lightstratify`: the light samples on a jittered √N × √N grid.
     pub light_stratify: bool,
+    /// When a branch's weight can no longer show ([`DepthControl::for_scene`]).
+    pub depth: DepthControl,
 }
 
 impl Whitted {
@@ -61,7 +94,7 @@ impl Whitted {
     /// hit; `None` when the ray escapes.
     fn shade(&self, t: &mut Tracing, ray: &Ray) -> Option<(Color, SurfacePoint)> {
         let scene = t.scene;
-        *t.rays += 1;
+        t.counts.rays += 1;
         let hit = scene.closest_hit(ray)?;
         let mut sp = scene.surface_point(&hit, ray);
         if let Some(light) = sp.light {
@@ -96,7 +129,7 @@ impl Whitted {
                     if reflected == Color::ZERO || inc.intensity == Color::ZERO {
                         continue;
                     }
-                    *t.rays += 1;
+                    t.counts.rays += 1;
                     // Aimed at a point on the light: stops just before it.
                     let shadow = Ray::segment(sp.point, inc.dir, EPSILON, inc.distance - EPSILON);
                     if !scene.occluded(&shadow) {
@@ -114,7 +147,7 @@ impl Whitted {
             if reflected == Color::ZERO || inc.intensity == Color::ZERO {
                 continue;
             }
-            *t.rays += 1;
+            t.counts.rays += 1;
             let shadow = Ray::segment(sp.point, inc.dir, EPSILON, inc.distance - EPSILON);
             if !scene.occluded(&shadow) {
                 color += inc.intensity * reflected;
@@ -125,25 +158,38 @@ impl Whitted {
 
     /// Adds `weight · I(ray)` to `total`. The mirror chain `I0 + S0 (I1 + S1 (…))` runs
     /// as a loop (the product of the specular colours so far weighs each hit's local
-    /// terms); only refraction and glossy reflection branch, by recursion.
-    fn trace(&self, t: &mut Tracing, ray: Ray, depth: u32, weight: Color, total: &mut Color) {
+    /// terms); where a hit branches — a refracted ray, glossy rays — the branches go on
+    /// the stack `pending`, the one to trace first on top.
+    fn follow(
+        &self,
+        t: &mut Tracing,
+        ray: Ray,
+        depth: u32,
+        weight: Color,
+        total: &mut Color,
+        pending: &mut Vec<Branch>,
+    ) {
         let scene = t.scene;
         let (mut ray, mut depth, mut weight) = (ray, depth, weight);
         loop {
+            if self.depth.negligible(weight) {
+                return;
+            }
             let Some((local, sp)) = self.shade(t, &ray) else {
                 if let Some(env) = &scene.environment {
                     *total += weight * env.radiance(ray.dir);
                 }
-                break;
+                return;
             };
             *total += weight * local;
             // A light's surface reflects nothing.
             if sp.light.is_some() || depth >= self.max_depth {
-                break;
+                return;
             }
             let m = &scene.materials[sp.material as usize];
             let (d, n) = (ray.dir, sp.normal);
             let mut mirror = m.specular;
+            let mut refracted = None;
             if m.transparent != Color::ZERO {
                 // Entering when the ray meets the side the normal points to.
                 let entering = d.dot(n) < 0.0;
@@ -152,43 +198,128 @@ impl Whitted {
                 let through = weight * m.transparent * (1.0 - f);
                 if f < 1.0 && through.max_element() > MIN_WEIGHT {
                     if let Some(dir) = refract(d, facing, n_i / n_t) {
-                        self.trace(t, Ray::new(sp.point, dir), depth + 1, through, total);
+                        refracted = Some(Branch::Ray {
+                            ray: Ray::new(sp.point, dir),
+                            depth: depth + 1,
+                            weight: through,
+                        });
                     }
                 }
                 mirror *= f;
             }
-            // (Opaque mirrors are never pruned: the course images depend on every bounce.)
+            // (Opaque mirrors are never pruned here: the course images depend on every
+            // bounce up to `maxdepth`, and adaptive depth control stops them where they
+            // cannot show.)
             let negligible = m.transparent != Color::ZERO && (weight * mirror).max_element() <= MIN_WEIGHT;
-            if mirror == Color::ZERO || negligible {
-                break;
-            }
-            let r = reflect(d, n).normalize();
-            if let Some(g) = m.glossy {
-                let count = if depth == 0 { g.samples.max(1) } else { 1 };
-                let w = weight * mirror / count as f32;
-                // Rays leave on the side the reflected ray is on.
-                let side = if r.dot(n) >= 0.0 { n } else { -n };
-                for _ in 0..count {
-                    let (u, v) = t.sampler.uniform2();
-                    let dir = phong_lobe(r, g.exponent, u, v);
-                    if dir.dot(side) > 0.0 {
-                        self.trace(t, Ray::new(sp.point, dir), depth + 1, w, total);
+            let reflected = if mirror == Color::ZERO || negligible {
+                None
+            } else {
+                let r = reflect(d, n).normalize();
+                Some(match m.glossy {
+                    Some(g) => {
+                        let count = if depth == 0 { g.samples.max(1) } else { 1 };
+                        Branch::Glossy {
+                            point: sp.point,
+                            mirror: r,
+                            // Rays leave on the side the reflected ray is on.
+                            side: if r.dot(n) >= 0.0 { n } else { -n },
+                            exponent: g.exponent,
+                            left: count,
+                            depth: depth + 1,
+                            weight: weight * mirror / count as f32,
+                        }
                     }
+                    None => Branch::Ray {
+                        ray: Ray::new(sp.point, r),
+                        depth: depth + 1,
+                        weight: weight * mirror,
+                    },
+                })
+            };
+            match (refracted, reflected) {
+                // The mirror chain goes on in this loop.
+                (
+                    None,
+                    Some(Branch::Ray {
+                        ray: r,
+                        depth: d,
+                        weight: w,
+                    }),
+                ) => (ray, depth, weight) = (r, d, w),
+                (None, None) => return,
+                // The refracted branch is traced first, then the reflected one.
+                (refracted, reflected) => {
+                    for b in [reflected, refracted].into_iter().flatten() {
+                        push(pending, b, t.counts);
+                    }
+                    return;
                 }
-                break;
             }
-            weight *= mirror;
-            ray = Ray::new(sp.point, r);
-            depth += 1;
+        }
+    }
+
+    /// Draws the next of a hit's glossy rays (`left` > 0 of them) and puts it on the
+    /// stack, above the rays still to draw, so that it is traced before they are drawn.
+    fn next_glossy(&self, t: &mut Tracing, glossy: Branch, pending: &mut Vec<Branch>) {
+        let Branch::Glossy {
+            point,
+            mirror,
+            side,
+            exponent,
+            left,
+            depth,
+            weight,
+        } = glossy
+        else {
+            unreachable!("only glossy branches draw")
+        };
+        let (u, v) = t.sampler.uniform2();
+        let dir = phong_lobe(mirror, exponent, u, v);
+        if left > 1 {
+            let rest = Branch::Glossy {
+                point,
+                mirror,
+                side,
+                exponent,
+                left: left - 1,
+                depth,
+                weight,
+            };
+            push(pending, rest, t.counts);
+        }
+        if dir.dot(side) > 0.0 {
+            let ray = Branch::Ray {
+                ray: Ray::new(point, dir),
+                depth,
+                weight,
+            };
+            push(pending, ray, t.counts);
         }
     }
 }
 
+/// Puts a branch on the stack, unless the stack is full ([`MAX_PENDING`]).
+fn push(pending: &mut Vec<Branch>, b: Branch, counts: &mut TraceCounts) {
+    if pending.len() < MAX_PENDING {
+        pending.push(b);
+    } else {
+        counts.cut_branches += 1;
+    }
+}
+
 impl Integrator for Whitted {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, rays: &mut u64) -> Color {
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
         let mut total = BACKGROUND;
-        let mut t = Tracing { scene, sampler, rays };
-        self.trace(&mut t, *ray, 0, Color::ONE, &mut total);
+        let mut t = Tracing { scene, sampler, counts };
+        // Only a tree that branches allocates.
+        let mut pending = Vec::new();
+        self.follow(&mut t, *ray, 0, Color::ONE, &mut total, &mut pending);
+        while let Some(b) = pending.pop() {
+            match b {
+                Branch::Ray { ray, depth, weight } => self.follow(&mut t, ray, depth, weight, &mut total, &mut pending),
+                glossy => self.next_glossy(&mut t, glossy, &mut pending),
+            }
+        }
         total
     }
 }

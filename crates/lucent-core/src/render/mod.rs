@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::film::Film;
-use crate::integrator::Integrator;
+use crate::integrator::{Integrator, TraceCounts};
 use crate::math::Color;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
@@ -31,6 +31,9 @@ pub struct RenderStats {
     pub rays: u64,
     /// Samples that came out NaN or infinite and were replaced by black.
     pub bad_samples: u64,
+    /// Branches of ray trees cut because too many were waiting at once
+    /// ([`crate::integrator::whitted::MAX_PENDING`]).
+    pub cut_branches: u64,
 }
 
 /// Hooks for the caller: `progress` is called after each tile with the number of pixels
@@ -93,6 +96,7 @@ pub fn render(
         let (pixels, s) = result?;
         stats.rays += s.rays;
         stats.bad_samples += s.bad_samples;
+        stats.cut_branches += s.cut_branches;
         let tw = (tile.x1 - tile.x0) as usize;
         for (row, chunk) in pixels.chunks(tw).enumerate() {
             let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
@@ -104,7 +108,8 @@ pub fn render(
 
 fn render_tile(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob, tile: &Tile) -> (Vec<Color>, RenderStats) {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
-    let mut stats = RenderStats::default();
+    let mut counts = TraceCounts::default();
+    let mut bad_samples = 0;
     let n = job.spp.max(1);
     let taken = job.samples.len() as u32;
     let mut lens_strata: Vec<u32> = Vec::new();
@@ -135,17 +140,22 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob, tile
                 let ray = scene
                     .camera
                     .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
-                let c = integrator.radiance(scene, &ray, &mut sampler, &mut stats.rays);
+                let c = integrator.radiance(scene, &ray, &mut sampler, &mut counts);
                 if c.is_finite() {
                     sum += c;
                 } else {
-                    stats.bad_samples += 1;
+                    bad_samples += 1;
                 }
             }
             // The box filter: every sample of the pixel counts the same.
             pixels.push(if taken == 1 { sum } else { sum / taken as f32 });
         }
     }
+    let stats = RenderStats {
+        rays: counts.rays,
+        bad_samples,
+        cut_branches: counts.cut_branches,
+    };
     (pixels, stats)
 }
 

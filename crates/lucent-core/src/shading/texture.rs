@@ -35,6 +35,11 @@ impl Image {
         top * (1.0 - fy) + bottom * fy
     }
 
+    /// The largest channel value of any texel (in absolute value).
+    pub fn max_channel(&self) -> f32 {
+        self.texels.iter().map(|c| c.abs().max_element()).fold(0.0, f32::max)
+    }
+
     /// The image at texture coordinates `uv` ((0, 0) bottom left, wrapping).
     pub fn at_uv(&self, uv: Vec2) -> Color {
         let (u, v) = (uv.x - uv.x.floor(), uv.y - uv.y.floor());

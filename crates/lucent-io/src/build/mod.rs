@@ -27,7 +27,7 @@ use lucent_core::scene::{Scene, SceneParts};
 use crate::desc::SceneDesc;
 use crate::diag::Diagnostics;
 
-pub use settings::UNBOUNDED_DEPTH_CAP;
+pub use settings::{Work, UNBOUNDED_DEPTH_CAP};
 
 #[derive(Clone, Copy, Debug)]
 pub struct BuildOptions {
@@ -55,6 +55,8 @@ pub struct Built {
     pub scene: Scene,
     pub integrator: Box<dyn Integrator>,
     pub settings: RenderSettings,
+    /// What rendering the whole image costs, about.
+    pub work: settings::Work,
 }
 
 impl Built {
@@ -74,7 +76,7 @@ pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) 
 }
 
 fn build_parts(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) -> Option<Built> {
-    let integrator = settings::integrator(desc, diags);
+    let mut integrator = settings::integrator(desc, diags);
     let (Some(size), Some(_)) = (&desc.size, &desc.camera) else {
         return None; // the parser has reported it
     };
@@ -102,14 +104,18 @@ fn build_parts(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics
         textures: materials.textures,
         environment,
     };
+    let scene = Scene::new(parts, options.accel);
+    settings::control_depth(&mut integrator, &scene);
+    let work = settings::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
     Some(Built {
-        scene: Scene::new(parts, options.accel),
-        integrator,
+        scene,
+        integrator: Box::new(integrator),
         settings: RenderSettings {
             resolution: Resolution { width, height },
             spp: desc.spp(),
             gamma: desc.gamma() as f32,
         },
+        work,
     })
 }
 
