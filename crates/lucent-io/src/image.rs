@@ -1,77 +1,35 @@
-//! Images out (and in, for comparisons). Output is written atomically: to a temporary
-//! file beside the target, then renamed over it, so a failed or interrupted run never
-//! leaves a partial image and never destroys an existing one.
+//! Images out and in: the encoders of the output formats (8-bit PNG, OpenEXR with 32-bit
+//! float channels, Radiance RGBE) — the bytes are written by
+//! [`crate::resources::OutputTarget`] — and the reader `lucent diff` compares images with.
 
-use std::fs::{self, File};
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use image::ImageEncoder;
 
-#[derive(Debug, thiserror::Error)]
-pub enum ImageError {
-    #[error("cannot write {path}: {reason}")]
-    Write { path: String, reason: String },
-    #[error("cannot read {path}: {reason}")]
-    Read { path: String, reason: String },
-}
+use crate::resources::{input::MAX_IMAGE_BYTES, read_input, Inputs};
 
-fn write_error(path: &Path, e: impl std::fmt::Display) -> ImageError {
-    ImageError::Write {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    }
-}
-
-fn io_write_error(path: &Path, e: &std::io::Error) -> ImageError {
-    write_error(path, crate::files::io_reason(e))
-}
-
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.lucent-tmp", std::process::id()))
-}
-
-/// Checks, before any work is done, that `path` can be written: its directory exists and
-/// takes a new file, and `path` is not a directory.
-pub fn check_writable(path: &Path) -> Result<(), ImageError> {
-    if path.as_os_str().is_empty() || path.file_name().is_none() {
-        return Err(write_error(path, "not a file name"));
-    }
-    if path.is_dir() {
-        return Err(write_error(path, "it is a directory"));
-    }
-    let tmp = temp_path(path);
-    File::create(&tmp).map_err(|e| io_write_error(path, &e))?;
-    let _ = fs::remove_file(&tmp);
-    Ok(())
-}
-
-/// Writes 8-bit RGB as PNG, atomically.
-pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), ImageError> {
+/// Encodes 8-bit RGB (interleaved, top row first) as PNG.
+pub fn encode_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, String> {
     let mut png = Vec::new();
     image::codecs::png::PngEncoder::new(&mut png)
         .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| write_error(path, e))?;
-    write_file_atomically(path, &png)
+        .map_err(|e| e.to_string())?;
+    Ok(png)
 }
 
-/// Writes linear RGB floats (interleaved, top row first) as an OpenEXR file (32-bit
-/// float channels), atomically: the render's values before clamping and encoding.
-pub fn write_exr(path: &Path, width: u32, height: u32, rgb: &[f32]) -> Result<(), ImageError> {
+/// Encodes linear RGB floats (interleaved, top row first) as an OpenEXR file (32-bit float
+/// channels): the render's values before clamping and encoding.
+pub fn encode_exr(width: u32, height: u32, rgb: &[f32]) -> Result<Vec<u8>, String> {
     let mut out = std::io::Cursor::new(Vec::new());
     let bytes: Vec<u8> = rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
     image::codecs::openexr::OpenExrEncoder::new(&mut out)
         .write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F)
-        .map_err(|e| write_error(path, e))?;
-    write_file_atomically(path, &out.into_inner())
+        .map_err(|e| e.to_string())?;
+    Ok(out.into_inner())
 }
 
-/// Writes linear RGB floats as a Radiance RGBE (`.hdr`) file, atomically.
-pub fn write_hdr(path: &Path, width: u32, height: u32, rgb: &[f32]) -> Result<(), ImageError> {
+/// Encodes linear RGB floats as a Radiance RGBE (`.hdr`) file.
+pub fn encode_hdr(width: u32, height: u32, rgb: &[f32]) -> Result<Vec<u8>, String> {
     let mut out = Vec::new();
     let pixels: Vec<image::Rgb<f32>> = rgb
         .chunks_exact(3)
@@ -79,26 +37,8 @@ pub fn write_hdr(path: &Path, width: u32, height: u32, rgb: &[f32]) -> Result<()
         .collect();
     image::codecs::hdr::HdrEncoder::new(&mut out)
         .encode(&pixels, width as usize, height as usize)
-        .map_err(|e| write_error(path, e))?;
-    write_file_atomically(path, &out)
-}
-
-/// Writes `bytes` to a temporary file beside `path`, syncs it and renames it over
-/// `path`: readers see the old file or the whole new one, never a part.
-pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageError> {
-    let tmp = temp_path(path);
-    let result = (|| {
-        let file = File::create(&tmp).map_err(|e| io_write_error(path, &e))?;
-        let mut out = BufWriter::new(file);
-        out.write_all(bytes).map_err(|e| io_write_error(path, &e))?;
-        let file = out.into_inner().map_err(|e| io_write_error(path, e.error()))?;
-        file.sync_all().map_err(|e| io_write_error(path, &e))?;
-        fs::rename(&tmp, path).map_err(|e| io_write_error(path, &e))
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
+        .map_err(|e| e.to_string())?;
+    Ok(out)
 }
 
 /// An 8-bit RGB image read from disk (PNG or JPEG).
@@ -108,14 +48,13 @@ pub struct Rgb8Image {
     pub data: Vec<u8>,
 }
 
-pub fn read_rgb8(path: &Path) -> Result<Rgb8Image, ImageError> {
-    let err = |e: &dyn std::fmt::Display| ImageError::Read {
-        path: path.display().to_string(),
-        reason: e.to_string(),
-    };
-    let reader = image::ImageReader::open(path).map_err(|e| err(&crate::files::io_reason(&e)))?;
-    let reader = reader.with_guessed_format().map_err(|e| err(&e))?;
-    let img = reader.decode().map_err(|e| err(&e))?.to_rgb8();
+/// Reads a PNG or JPEG file (a regular file) as 8-bit RGB; the error says why not.
+pub fn read_rgb8(path: &Path) -> Result<Rgb8Image, String> {
+    let bytes = read_input(path, MAX_IMAGE_BYTES, &mut Inputs::default())?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    let img = reader.decode().map_err(|e| e.to_string())?.to_rgb8();
     Ok(Rgb8Image {
         width: img.width(),
         height: img.height(),

@@ -15,8 +15,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod diag;
-pub mod files;
 mod number;
+pub mod resources;
 
 pub mod desc;
 

@@ -5,6 +5,8 @@ use std::path::Path;
 
 use lucent_core::geometry::mesh::TriangleMesh;
 
+use crate::resources::Resources;
+
 /// What a mesh file gives besides its triangles: the materials it names, and what the
 /// loader had to leave out.
 #[derive(Debug, Default)]
@@ -31,22 +33,26 @@ pub struct MeshMaterial {
     pub diffuse_texture: Option<String>,
 }
 
-/// Loads an OBJ or PLY file, chosen by its extension.
-pub fn load_mesh(path: &Path) -> Result<LoadedMesh, String> {
+/// Loads an OBJ or PLY file, chosen by its extension; every file read is recorded in
+/// `inputs`.
+pub fn load_mesh(path: &Path, res: &mut Resources) -> Result<LoadedMesh, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("obj") => crate::obj::load_obj(path),
-        Some("ply") => crate::ply::load_ply(path),
+        Some("obj") => crate::obj::load_obj(path, res),
+        Some("ply") => crate::ply::load_ply(path, res),
         _ => Err("unknown mesh format (expected a .obj or .ply file)".into()),
     }
 }
 
 /// Loads the polygons of an OBJ or PLY file, untriangulated (for `subdivmesh`).
-pub fn load_polygons(path: &Path) -> Result<lucent_core::tessellate::subdivision::ControlMesh, String> {
+pub fn load_polygons(
+    path: &Path,
+    res: &mut Resources,
+) -> Result<lucent_core::tessellate::subdivision::ControlMesh, String> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("obj") => crate::obj::load_obj_polygons(path),
-        Some("ply") => crate::ply::load_ply_polygons(path),
+        Some("obj") => crate::obj::load_obj_polygons(path, res),
+        Some("ply") => crate::ply::load_ply_polygons(path, res),
         _ => Err("unknown mesh format (expected a .obj or .ply file)".into()),
     }
 }

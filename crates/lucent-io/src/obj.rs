@@ -6,20 +6,123 @@
 //! goes into one mesh; vertices that share a position but not a normal or texture
 //! coordinate are split (tobj's `single_index`).
 
+use std::cell::RefCell;
 use std::path::Path;
 
 use crate::mesh_file::{LoadedMesh, MeshMaterial, NO_MATERIAL};
+use crate::resources::input::{MAX_MESH_BYTES, MAX_SMALL_FILE_BYTES};
+use crate::resources::{read_input, Resources};
 use glam::{DVec3, Vec2, Vec3};
 use lucent_core::tessellate::subdivision::ControlMesh;
 
-pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
+/// The models of an OBJ file and its MTL library (or why the library could not be
+/// read), every file read through [`read_input`] and recorded in `res`.
+type Obj = (Vec<tobj::Model>, Result<Vec<tobj::Material>, String>);
+
+fn read_obj(path: &Path, options: &tobj::LoadOptions, res: &mut Resources) -> Result<Obj, String> {
+    let bytes = read_input(path, MAX_MESH_BYTES, &mut res.inputs).map_err(|e| format!("cannot open: {e}"))?;
+    check_face_references(&bytes)?;
+    let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let inputs = RefCell::new(&mut res.inputs);
+    // Why the library could not be read, when the reason is ours (tobj only has codes).
+    let reason = RefCell::new(None);
+    let load_mtl = |name: &Path| {
+        let text = read_input(&dir.join(name), MAX_SMALL_FILE_BYTES, &mut inputs.borrow_mut()).map_err(|e| {
+            *reason.borrow_mut() = Some(e);
+            tobj::LoadError::OpenFileFailed
+        })?;
+        tobj::load_mtl_buf(&mut &text[..])
+    };
+    let (models, materials) =
+        tobj::load_obj_buf(&mut &bytes[..], options, load_mtl).map_err(|e| format!("cannot read OBJ mesh: {e}"))?;
+    let materials = materials.map_err(|e| match reason.take() {
+        Some(r) => r,
+        None if e == tobj::LoadError::GenericFailure => String::new(),
+        None => e.to_string(),
+    });
+    if let Ok(list) = &materials {
+        for m in list {
+            check_material(m)?;
+        }
+    }
+    Ok((models, materials))
+}
+
+/// An MTL material's numbers must be numbers (`Kd nan` is an error, as in the OBJ).
+fn check_material(m: &tobj::Material) -> Result<(), String> {
+    let colours = [("Kd", m.diffuse), ("Ks", m.specular), ("Ke", m.emissive)];
+    for (key, v) in colours {
+        if let Some(v) = v {
+            if v.iter().any(|c| !c.is_finite()) {
+                return Err(format!(
+                    "material '{}': {key} {v:?} is not three finite numbers",
+                    m.name
+                ));
+            }
+        }
+    }
+    if let Some(ns) = m.shininess {
+        if !(ns >= 0.0 && ns.is_finite()) {
+            return Err(format!("material '{}': Ns {ns} is not a number ≥ 0", m.name));
+        }
+    }
+    Ok(())
+}
+
+/// Every face's vertex, texture coordinate and normal references name an element of the
+/// file (1-based; negative: counted back from the last one defined before the face).
+fn check_face_references(bytes: &[u8]) -> Result<(), String> {
+    let text = String::from_utf8_lossy(bytes);
+    let lines = || text.lines().map(|l| l.trim_start());
+    let count = |key: &str| lines().filter(|l| l.split_whitespace().next() == Some(key)).count() as i64;
+    let totals = [count("v"), count("vt"), count("vn")];
+    let mut so_far = [0i64; 3];
+    const NAMES: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+    for (n, line) in lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => so_far[0] += 1,
+            Some("vt") => so_far[1] += 1,
+            Some("vn") => so_far[2] += 1,
+            Some("f") => {
+                for corner in words {
+                    for (k, index) in corner.split('/').enumerate().take(3) {
+                        if index.is_empty() {
+                            continue; // `v//vn`
+                        }
+                        let Ok(i) = index.parse::<i64>() else {
+                            return Err(format!("line {}: '{corner}' is not a face corner", n + 1));
+                        };
+                        let ok = if i > 0 {
+                            i <= totals[k]
+                        } else {
+                            i < 0 && -i <= so_far[k]
+                        };
+                        if !ok {
+                            return Err(format!(
+                                "line {}: a face refers to {} {i}, but the file has {}",
+                                n + 1,
+                                NAMES[k],
+                                totals[k]
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+pub fn load_obj(path: &Path, res: &mut Resources) -> Result<LoadedMesh, String> {
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, materials) = tobj::load_obj(path, &options).map_err(|e| format!("cannot read OBJ mesh: {e}"))?;
+    let (models, materials) = read_obj(path, &options, res)?;
     let mut out = LoadedMesh::default();
     match materials {
         Ok(list) => {
@@ -36,9 +139,10 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
                 .collect()
         }
         Err(e) => {
-            if models.iter().any(|m| m.mesh.material_id.is_some()) || e != tobj::LoadError::GenericFailure {
+            if models.iter().any(|m| m.mesh.material_id.is_some()) || !e.is_empty() {
+                let why = if e.is_empty() { "no library" } else { e.as_str() };
                 out.warnings.push(format!(
-                    "cannot read the MTL material library ({e}); the current material is used"
+                    "cannot read the MTL material library ({why}); the current material is used"
                 ));
             }
         }
@@ -98,14 +202,14 @@ pub fn load_obj(path: &Path) -> Result<LoadedMesh, String> {
 
 /// The polygons of an OBJ file as they are, on shared positions (for subdivision):
 /// texture coordinates and normals are left out, since subdivision makes its own.
-pub fn load_obj_polygons(path: &Path) -> Result<ControlMesh, String> {
+pub fn load_obj_polygons(path: &Path, res: &mut Resources) -> Result<ControlMesh, String> {
     let options = tobj::LoadOptions {
         triangulate: false,
         single_index: false,
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _) = tobj::load_obj(path, &options).map_err(|e| format!("cannot read OBJ mesh: {e}"))?;
+    let (models, _) = read_obj(path, &options, res)?;
     let mut out = ControlMesh::default();
     for model in &models {
         let m = &model.mesh;
@@ -160,14 +264,14 @@ mod tests {
             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\n# a quad, then a triangle\nf 1 2 3 4\nf 1 2 5\n",
         )
         .unwrap();
-        let m = load_obj(&path).unwrap().mesh;
+        let m = load_obj(&path, &mut Resources::new(u64::MAX)).unwrap().mesh;
         assert_eq!(m.indices.len(), 3);
         let z = |k: u32| m.corners(k).map(|p| (p.x, p.y, p.z));
         assert_eq!(z(0), [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (1.0, 1.0, 0.0)]);
         assert_eq!(z(1), [(0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (0.0, 1.0, 0.0)]);
         assert_eq!(z(2), [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)]);
         assert!(m.normals.is_empty() && m.uvs.is_empty() && m.materials.is_empty());
-        assert!(load_obj(&dir.join("missing.obj")).is_err());
+        assert!(load_obj(&dir.join("missing.obj"), &mut Resources::new(u64::MAX)).is_err());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -185,7 +289,7 @@ mod tests {
              usemtl red\nf 1/1/1 2/2/1 3/3/1\nusemtl glow\nf 1/1/1 3/3/1 2/2/1\n",
         )
         .unwrap();
-        let loaded = load_obj(&dir.join("two.obj")).unwrap();
+        let loaded = load_obj(&dir.join("two.obj"), &mut Resources::new(u64::MAX)).unwrap();
         let m = &loaded.mesh;
         assert_eq!(m.indices.len(), 2);
         assert_eq!(m.normals.len(), m.positions.len());
@@ -200,7 +304,7 @@ mod tests {
 
         // A missing library is a warning; the faces keep the current material.
         std::fs::remove_file(dir.join("two.mtl")).unwrap();
-        let loaded = load_obj(&dir.join("two.obj")).unwrap();
+        let loaded = load_obj(&dir.join("two.obj"), &mut Resources::new(u64::MAX)).unwrap();
         assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
         assert!(loaded.mesh.materials.is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
@@ -215,7 +319,10 @@ mod tests {
             ("face.obj", "v 0 0 0\nf 1 x 3\n"),
         ] {
             std::fs::write(dir.join(name), text).unwrap();
-            assert!(load_obj(&dir.join(name)).is_err(), "{name}");
+            assert!(
+                load_obj(&dir.join(name), &mut Resources::new(u64::MAX)).is_err(),
+                "{name}"
+            );
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -16,6 +16,8 @@ use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property, PropertyAccess};
 
 use crate::mesh_file::LoadedMesh;
+use crate::resources::input::MAX_MESH_BYTES;
+use crate::resources::{open_input, Resources};
 
 /// One `vertex` element: every property lucent understands, `NaN` where absent.
 struct Vertex {
@@ -101,9 +103,9 @@ impl PropertyAccess for Face {
 
 /// The vertices and faces of a PLY file, faces checked (at least three corners, every
 /// index a vertex).
-fn read_ply(path: &Path) -> Result<(Vec<Vertex>, Vec<Face>), String> {
-    let file = std::fs::File::open(path).map_err(|e| format!("cannot open: {}", crate::files::io_reason(&e)))?;
-    let mut reader = BufReader::new(file);
+fn read_ply(path: &Path, res: &mut Resources) -> Result<(Vec<Vertex>, Vec<Face>), String> {
+    let (file, size) = open_input(path, MAX_MESH_BYTES, &mut res.inputs).map_err(|e| format!("cannot open: {e}"))?;
+    let mut reader = BufReader::new(std::io::Read::take(file, size));
     let bad = |e: std::io::Error| format!("malformed PLY file: {e}");
     let vertex_parser = Parser::<Vertex>::new();
     let face_parser = Parser::<Face>::new();
@@ -156,8 +158,8 @@ fn read_ply(path: &Path) -> Result<(Vec<Vertex>, Vec<Face>), String> {
 }
 
 /// The polygons of a PLY file as they are (for subdivision).
-pub fn load_ply_polygons(path: &Path) -> Result<ControlMesh, String> {
-    let (vertices, faces) = read_ply(path)?;
+pub fn load_ply_polygons(path: &Path, res: &mut Resources) -> Result<ControlMesh, String> {
+    let (vertices, faces) = read_ply(path, res)?;
     Ok(ControlMesh {
         positions: vertices.iter().map(|v| DVec3::from_array(v.p)).collect(),
         faces: faces
@@ -167,8 +169,8 @@ pub fn load_ply_polygons(path: &Path) -> Result<ControlMesh, String> {
     })
 }
 
-pub fn load_ply(path: &Path) -> Result<LoadedMesh, String> {
-    let (vertices, faces) = read_ply(path)?;
+pub fn load_ply(path: &Path, res: &mut Resources) -> Result<LoadedMesh, String> {
+    let (vertices, faces) = read_ply(path, res)?;
     let mut mesh = TriangleMesh::default();
     for (k, v) in vertices.iter().enumerate() {
         if v.p.iter().any(|c| !c.is_finite()) {
@@ -222,7 +224,9 @@ mod tests {
     #[test]
     fn ascii_quads_are_fanned_with_normals_and_uvs() {
         let text = format!("{HEADER}0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n");
-        let m = load_ply(&write("quad.ply", text.as_bytes())).unwrap().mesh;
+        let m = load_ply(&write("quad.ply", text.as_bytes()), &mut Resources::new(u64::MAX))
+            .unwrap()
+            .mesh;
         assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(m.normals, vec![Vec3::Z; 4]);
         assert_eq!(m.uvs[2], Vec2::new(1.0, 1.0));
@@ -246,7 +250,9 @@ mod tests {
         }
         bytes.extend(0i32.to_le_bytes());
         bytes.extend(1i32.to_le_bytes());
-        let m = load_ply(&write("bin.ply", &bytes)).unwrap().mesh;
+        let m = load_ply(&write("bin.ply", &bytes), &mut Resources::new(u64::MAX))
+            .unwrap()
+            .mesh;
         assert_eq!(m.indices, vec![[0, 1, 2]]);
         assert_eq!(m.positions[2], Vec3::new(0.0, 2.0, 0.0));
         assert!(m.normals.is_empty() && m.uvs.is_empty());
@@ -271,9 +277,9 @@ mod tests {
             ("text.ply", "not a ply file\n".into()),
         ];
         for (name, text) in cases {
-            let e = load_ply(&write(name, text.as_bytes()));
+            let e = load_ply(&write(name, text.as_bytes()), &mut Resources::new(u64::MAX));
             assert!(e.is_err(), "{name}");
         }
-        assert!(load_ply(Path::new("/nonexistent/x.ply")).is_err());
+        assert!(load_ply(Path::new("/nonexistent/x.ply"), &mut Resources::new(u64::MAX)).is_err());
     }
 }

@@ -15,12 +15,15 @@ use crate::build::{build, BuildOptions, Built};
 use crate::cse167::{parse_bytes, parse_file, ParseOptions};
 use crate::desc::SceneDesc;
 use crate::diag::Diagnostics;
+use crate::resources::{Budget, Resources};
 
 #[derive(Clone, Copy, Debug)]
 pub struct SessionOptions {
     /// Unknown commands are errors instead of warnings.
     pub strict: bool,
     pub accel: AccelKind,
+    /// The memory budget in bytes ([`crate::resources::budget`]).
+    pub memory_limit: u64,
 }
 
 impl Default for SessionOptions {
@@ -28,6 +31,7 @@ impl Default for SessionOptions {
         SessionOptions {
             strict: false,
             accel: AccelKind::Bvh,
+            memory_limit: Budget::machine_default(),
         }
     }
 }
@@ -38,6 +42,9 @@ pub struct Session {
     pub desc: SceneDesc,
     pub diags: Diagnostics,
     pub built: Option<Built>,
+    /// Every file read so far (the scene file, then what the build read) and the memory
+    /// budget.
+    pub res: Resources,
     pub parse_seconds: f64,
     pub build_seconds: f64,
     options: SessionOptions,
@@ -46,7 +53,12 @@ pub struct Session {
 impl Session {
     /// Parses a scene file; nothing is built yet ([`Session::build`]).
     pub fn parse_file(path: &Path, options: SessionOptions) -> Session {
-        Session::parse_with(options, || parse_file(path, ParseOptions { strict: options.strict }))
+        let mut res = Resources::new(options.memory_limit);
+        let mut s = Session::parse_with(options, || {
+            parse_file(path, ParseOptions { strict: options.strict }, &mut res)
+        });
+        s.res = res;
+        s
     }
 
     /// Parses scene text; `name` is what diagnostics call it, and the files it names are
@@ -64,6 +76,7 @@ impl Session {
             desc,
             diags,
             built: None,
+            res: Resources::new(options.memory_limit),
             parse_seconds: start.elapsed().as_secs_f64(),
             build_seconds: 0.0,
             options,
@@ -84,7 +97,7 @@ impl Session {
             let options = BuildOptions {
                 accel: self.options.accel,
             };
-            self.built = build(&self.desc, &options, &mut self.diags);
+            self.built = build(&self.desc, &options, &mut self.res, &mut self.diags);
             self.build_seconds = start.elapsed().as_secs_f64();
         }
         self.built.is_some()

@@ -1,71 +1,104 @@
-//! Texture and environment images from files: PNG and JPEG (8 or 16 bits, decoded from
-//! sRGB to linear), Radiance HDR and OpenEXR (linear already).
+//! Texture and environment images from files: PNG and JPEG (8 or 16 bits, sRGB), Radiance
+//! HDR and OpenEXR (linear). The file must be a regular file; its size in texels is read
+//! from its header first, and the memory its decoding takes is taken from the budget
+//! before any of it is allocated (the decoder is held to the same bound).
 
+use std::io::Cursor;
 use std::path::Path;
 
-use lucent_core::math::Color;
-use lucent_core::shading::texture::{srgb_to_linear, srgb_value_to_linear, Image};
+use image::{DynamicImage, ImageDecoder, ImageReader};
+use lucent_core::shading::texture::{srgb_value_to_linear, Image};
+
+use crate::resources::input::MAX_IMAGE_BYTES;
+use crate::resources::{read_input, Resources};
 
 /// The largest image accepted, in texels (a 16k × 16k picture).
 const MAX_TEXELS: u64 = 1 << 28;
 
-pub fn load_image(path: &Path) -> Result<Image, String> {
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| format!("cannot open: {}", crate::files::io_reason(&e)))?
+/// Reads an image file as a texture, taking its memory from `res`'s budget.
+pub fn load_image(path: &Path, res: &mut Resources) -> Result<Image, String> {
+    let bytes = read_input(path, MAX_IMAGE_BYTES, &mut res.inputs).map_err(|e| format!("cannot open: {e}"))?;
+    let decoder = ImageReader::new(Cursor::new(&bytes[..]))
         .with_guessed_format()
-        .map_err(|e| format!("cannot read: {e}"))?;
-    let img = reader.decode().map_err(|e| format!("cannot decode the image: {e}"))?;
-    let (width, height) = (img.width(), img.height());
-    if width == 0 || height == 0 || width as u64 * height as u64 > MAX_TEXELS {
+        .map_err(|e| format!("cannot read: {e}"))?
+        .into_decoder()
+        .map_err(|e| format!("cannot decode the image: {e}"))?;
+    let (width, height) = decoder.dimensions();
+    let texels = width as u64 * height as u64;
+    if width == 0 || height == 0 || texels > MAX_TEXELS {
         return Err(format!("unusable image size {width} x {height}"));
     }
+    // Decoding makes the file's own pixels, then ours: 3 bytes a texel for 8-bit files,
+    // 12 for the others.
+    let decoded = decoder.total_bytes();
+    let eight_bit = decoder.color_type().bytes_per_pixel() / decoder.color_type().channel_count().max(1) == 1;
+    let kept = texels * if eight_bit { 3 } else { 12 };
+    let what = format!("the {width} x {height} image");
+    res.budget.take(decoded + kept, &what)?;
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(decoded.max(kept) + (1 << 20));
+    let mut decoder = decoder;
+    decoder
+        .set_limits(limits)
+        .map_err(|e| format!("cannot decode the image: {e}"))?;
+    let img = DynamicImage::from_decoder(decoder).map_err(|e| format!("cannot decode the image: {e}"))?;
+    // The decoded pixels are gone once ours are made.
+    res.budget.give_back(decoded);
     use image::DynamicImage as D;
-    let texels: Vec<Color> = match &img {
-        D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
-            img.to_rgb32f().pixels().map(|p| Color::new(p[0], p[1], p[2])).collect()
+    let image = match img {
+        D::ImageRgb32F(_) | D::ImageRgba32F(_) => Image::linear(width, height, img.into_rgb32f().into_raw()),
+        D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
+            let v = img.into_rgb16().into_raw();
+            Image::linear(
+                width,
+                height,
+                v.iter().map(|&c| srgb_value_to_linear(c as f32 / 65535.0)).collect(),
+            )
         }
-        D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => img
-            .to_rgb16()
-            .pixels()
-            .map(|p| Color::from_array(p.0.map(|c| srgb_value_to_linear(c as f32 / 65535.0))))
-            .collect(),
-        _ => img
-            .to_rgb8()
-            .pixels()
-            .map(|p| Color::from_array(p.0.map(srgb_to_linear)))
-            .collect(),
+        _ => Image::srgb8(width, height, img.into_rgb8().into_raw()),
     };
-    if texels.iter().any(|c| !c.is_finite()) {
+    if !image.max_channel().is_finite() {
         return Err("the image holds values that are not finite numbers".into());
     }
-    Ok(Image { width, height, texels })
+    Ok(image)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use lucent_core::math::Color;
 
     #[test]
     fn eight_bit_images_are_decoded_from_srgb_and_float_images_kept() {
         let dir = std::env::temp_dir().join(format!("lucent-tex-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
+        let mut res = Resources::new(u64::MAX);
         let png = dir.join("t.png");
         image::RgbImage::from_raw(2, 1, vec![255, 188, 0, 0, 0, 255])
             .unwrap()
             .save(&png)
             .unwrap();
-        let img = load_image(&png).unwrap();
+        let img = load_image(&png, &mut res).unwrap();
         assert_eq!((img.width, img.height), (2, 1));
-        assert!((img.texels[0].x - 1.0).abs() < 1e-6 && (img.texels[0].y - 0.5).abs() < 0.01);
+        let t = img.texel_at(0);
+        assert!((t.x - 1.0).abs() < 1e-6 && (t.y - 0.5).abs() < 0.01);
+        assert_eq!(img.memory_bytes(), 6, "3 bytes a texel");
         let exr = dir.join("t.exr");
         image::Rgb32FImage::from_raw(1, 1, vec![2.5, 0.25, 0.0])
             .unwrap()
             .save(&exr)
             .unwrap();
-        assert_eq!(load_image(&exr).unwrap().texels[0], Color::new(2.5, 0.25, 0.0));
+        assert_eq!(
+            load_image(&exr, &mut res).unwrap().texel_at(0),
+            Color::new(2.5, 0.25, 0.0)
+        );
         std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
-        assert!(load_image(&dir.join("bad.png")).is_err());
-        assert!(load_image(&dir.join("missing.png")).is_err());
+        assert!(load_image(&dir.join("bad.png"), &mut res).is_err());
+        assert!(load_image(&dir.join("missing.png"), &mut res).is_err());
+        // The budget is taken before decoding: 2 texels need 6 + 6 bytes.
+        let mut small = Resources::new(10);
+        let e = load_image(&png, &mut small).unwrap_err();
+        assert!(e.contains("the 2 x 1 image needs about 12 bytes"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

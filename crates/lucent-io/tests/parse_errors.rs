@@ -459,6 +459,7 @@ fn the_shipped_teapot_scene_tessellates() {
     let options = SessionOptions {
         strict: true,
         accel: lucent_core::accel::AccelKind::List,
+        ..SessionOptions::default()
     };
     let session = Session::open(&path, options);
     let (desc, diags) = (&session.desc, &session.diags);

@@ -18,6 +18,9 @@ pub struct CheckArgs {
     /// Treat unknown commands as errors.
     #[arg(long)]
     pub strict: bool,
+    /// The memory the scene may take (e.g. 4G, 512M); default: 3/4 of the machine's.
+    #[arg(long, value_name = "SIZE", value_parser = crate::render::parse_size)]
+    pub memory_limit: Option<u64>,
 }
 
 pub fn run(args: &CheckArgs) -> u8 {
@@ -25,6 +28,9 @@ pub fn run(args: &CheckArgs) -> u8 {
     let options = SessionOptions {
         strict: args.strict,
         accel: AccelKind::List,
+        memory_limit: args
+            .memory_limit
+            .unwrap_or_else(lucent_io::resources::Budget::machine_default),
     };
     let session = Session::open(&args.scene, options);
     report(&session.diags, &session.desc.sources, true);

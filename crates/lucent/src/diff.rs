@@ -19,13 +19,22 @@ pub struct DiffArgs {
     /// Fail when more pixels than this differ.
     #[arg(long)]
     pub max_pixels: Option<usize>,
-    /// Fail when the mean absolute error is this or more.
-    #[arg(long)]
+    /// Fail when the mean absolute error is this or more (a number ≥ 0).
+    #[arg(long, value_parser = non_negative)]
     pub max_mae: Option<f64>,
 }
 
+/// A finite number ≥ 0: `nan` would let every pair of images pass.
+fn non_negative(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("'{s}' is not a number ≥ 0")),
+    }
+}
+
 pub fn run(args: &DiffArgs) -> u8 {
-    let (a, b) = match (read_rgb8(&args.a), read_rgb8(&args.b)) {
+    let read = |p: &std::path::Path| read_rgb8(p).map_err(|e| format!("cannot read {}: {e}", p.display()));
+    let (a, b) = match (read(&args.a), read(&args.b)) {
         (Ok(a), Ok(b)) => (a, b),
         (Err(e), _) | (_, Err(e)) => {
             eprintln!("lucent: error: {e}");

@@ -4,16 +4,21 @@
 mod bench;
 mod check;
 mod diff;
+mod oom;
 mod output;
 mod progress;
 mod render;
+mod signals;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-/// Exit code for bad input, missing files and unwritable output.
+/// Exit code for bad input, missing files, unwritable output and lack of memory.
 pub const EXIT_BAD_INPUT: u8 = 2;
+
+#[global_allocator]
+static ALLOCATOR: oom::ExitOnFailure = oom::ExitOnFailure;
 
 #[derive(Parser)]
 #[command(

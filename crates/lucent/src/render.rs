@@ -1,23 +1,27 @@
 //! `lucent render SCENE [-o OUT.png] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
-use lucent_io::image::check_writable;
+use lucent_core::integrator::whitted::MAX_PENDING;
+use lucent_io::resources::input::FileId;
+use lucent_io::resources::Budget;
 use lucent_io::session::{Renderer, Session, SessionOptions};
 
 use crate::output::{choose_output, report};
 use crate::progress::Progress;
+use crate::signals;
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
 pub struct RenderArgs {
     /// The scene file (CSE167/CSE168 format).
     pub scene: PathBuf,
-    /// Output image; default: the scene's `output` command, else raytrace.png.
+    /// Output image (`-` for standard output); default: the scene's `output` command,
+    /// else raytrace.png.
     #[arg(short, long, value_name = "OUT.png")]
     pub output: Option<PathBuf>,
     /// Worker threads (default: all cores). The image is the same for any count.
@@ -29,6 +33,9 @@ pub struct RenderArgs {
     /// Treat unknown commands as errors.
     #[arg(long)]
     pub strict: bool,
+    /// The memory the scene may take (e.g. 4G, 512M); default: 3/4 of the machine's.
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub memory_limit: Option<u64>,
     /// No progress bar and no summary line (warnings and errors are still printed).
     #[arg(short, long)]
     pub quiet: bool,
@@ -37,19 +44,27 @@ pub struct RenderArgs {
     pub stats: bool,
 }
 
+/// `--memory-limit`: a size as people write it (`4G`, `512MiB`, bytes).
+pub fn parse_size(s: &str) -> Result<u64, String> {
+    lucent_io::resources::budget::parse_size(s)
+}
+
 pub fn run(args: &RenderArgs) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t_start = Instant::now();
+    signals::install();
     let options = SessionOptions {
         strict: args.strict,
         accel,
+        memory_limit: args.memory_limit.unwrap_or_else(Budget::machine_default),
     };
     let mut session = Session::parse_file(&args.scene, options);
     if session.diags.has_errors() {
         report(&session.diags, &session.desc.sources, false);
         return EXIT_BAD_INPUT;
     }
-    // The output is checked before the build, which may take long.
+    // The output is checked before the build, which may take long: that it can be
+    // written, and that it is none of the files the scene names.
     let out = match choose_output(args.output.as_deref(), &session.desc, &mut session.diags) {
         Ok(out) => out,
         Err(msg) => {
@@ -58,9 +73,15 @@ pub fn run(args: &RenderArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
-    if let Err(e) = check_writable(&out) {
+    let mut named = session.res.inputs.clone();
+    for p in session.desc.named_files() {
+        if let Ok(meta) = std::fs::metadata(p) {
+            named.record(FileId::of(&meta), p);
+        }
+    }
+    if let Err(e) = out.target.check_not_input(&named) {
         report(&session.diags, &session.desc.sources, false);
-        eprintln!("lucent: error: {e}");
+        eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
         return EXIT_BAD_INPUT;
     }
     session.build();
@@ -75,19 +96,33 @@ pub fn run(args: &RenderArgs) -> u8 {
     };
     let job = built.job();
     let progress = Progress::new(job.pixels.pixels(), args.quiet);
-    let cancel = AtomicBool::new(false);
+    let cancel = signals::cancel_flag();
     let t_render = Instant::now();
-    let (film, stats) = renderer
-        .render(built, &job, &|n| progress.advance(n), &cancel)
-        .expect("never cancelled");
+    let rendered = renderer.render(built, &job, &|n| progress.advance(n), cancel);
     let t_rendered = Instant::now();
     progress.finish();
+    let Some((film, stats)) = rendered.filter(|_| !cancel.load(Ordering::Relaxed)) else {
+        eprintln!("lucent: interrupted; nothing written");
+        return signals::exit_code();
+    };
 
     if stats.bad_samples > 0 {
         eprintln!(
             "lucent: warning: {} samples were NaN or infinite and were replaced by black",
             stats.bad_samples
         );
+    }
+    if stats.cut_branches > 0 {
+        eprintln!(
+            "lucent: warning: {} ray branches were not traced: too many were waiting at once (mirrors and glass that reflect everything, and a maxdepth above {})",
+            stats.cut_branches,
+            MAX_PENDING / 2
+        );
+    }
+    // Everything the build read (MTL libraries and their images too) is an input.
+    if let Err(e) = out.target.check_not_input(&session.res.inputs) {
+        eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
+        return EXIT_BAD_INPUT;
     }
     if let Err(e) = crate::output::write_image(&out, &film, built.settings.gamma) {
         eprintln!("lucent: error: {e}");
@@ -106,7 +141,7 @@ pub fn run(args: &RenderArgs) -> u8 {
             stats.rays,
             render_s,
             stats.rays as f64 / render_s.max(1e-9) / 1e6,
-            out.display()
+            out.name.display()
         );
     }
     if args.stats {

@@ -36,7 +36,7 @@ const CORE: Floors = &[
 const IO: Floors = &[
     ("diag", 0),
     ("number", 0),
-    ("files", 0),
+    ("resources", 0),
     ("desc", 1),
     ("cse167", 2),
     ("mesh_file", 3),
@@ -52,6 +52,8 @@ const IO: Floors = &[
 const CLI: Floors = &[
     ("output", 0),
     ("progress", 0),
+    ("signals", 0),
+    ("oom", 0),
     ("render", 1),
     ("check", 1),
     ("diff", 1),

@@ -23,6 +23,9 @@ use crate::scene::Scene;
 use job::RenderJob;
 
 pub const TILE_SIZE: u32 = 16;
+/// Samples of one pixel between two looks at the cancel flag (so that even a pixel of a
+/// billion samples stops at once).
+const CANCEL_EVERY: u32 = 64;
 
 /// What the render loop reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -83,7 +86,7 @@ pub fn render(
             if control.cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let out = render_tile(scene, integrator, job, tile);
+            let out = render_tile(scene, integrator, job, tile, control.cancel)?;
             (control.progress)(out.0.len() as u64);
             Some(out)
         })
@@ -106,7 +109,15 @@ pub fn render(
     Some((film, stats))
 }
 
-fn render_tile(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob, tile: &Tile) -> (Vec<Color>, RenderStats) {
+/// The pixels of one tile; `None` as soon as `cancel` is set (it is looked at between
+/// pixels and every [`CANCEL_EVERY`] samples).
+fn render_tile(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    job: &RenderJob,
+    tile: &Tile,
+    cancel: &AtomicBool,
+) -> Option<(Vec<Color>, RenderStats)> {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
@@ -120,6 +131,9 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob, tile
             }
             let mut sum = Color::ZERO;
             for i in job.samples.clone() {
+                if i % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
+                    return None;
+                }
                 let mut sampler = Sampler::new(job.seed, x, y, i);
                 // One sample goes through the pixel centre; more are jittered over the
                 // pixel (one per cell of a √n × √n grid when n is a square).
@@ -156,7 +170,7 @@ fn render_tile(scene: &Scene, integrator: &dyn Integrator, job: &RenderJob, tile
         bad_samples,
         cut_branches: counts.cut_branches,
     };
-    (pixels, stats)
+    Some((pixels, stats))
 }
 
 /// `0..n` in an order drawn from the pixel alone (Fisher–Yates), reusing `out`'s storage.

@@ -1,7 +1,7 @@
 //! Textures (`texture`, `checker`) and the environment map (`envmap`).
 //!
-//! Image textures hold linear RGB (8-bit files are decoded from sRGB when loaded) and are
-//! filtered bilinearly with wrapping; texture coordinates run from (0, 0) at the bottom
+//! Image textures hold linear RGB (8-bit files keep their sRGB bytes, decoded by a table
+//! on lookup: 3 bytes a texel instead of 12) and are filtered bilinearly with wrapping; texture coordinates run from (0, 0) at the bottom
 //! left of the image to (1, 1) at the top right, as in OBJ files. The checker is a solid
 //! texture of the world-space hit point.
 
@@ -9,18 +9,80 @@ use crate::math::{Color, Vec3A};
 use crate::tessellate::displacement::{Detail, HeightField};
 use glam::Vec2;
 
-/// An image in linear RGB, row 0 at the top.
+/// An image of linear RGB values, row 0 at the top.
 #[derive(Clone, Debug)]
 pub struct Image {
     pub width: u32,
     pub height: u32,
-    pub texels: Vec<Color>,
+    texels: Texels,
+}
+
+/// The texels, row by row, three values each, kept as compact as the file allows.
+#[derive(Clone, Debug)]
+enum Texels {
+    /// 8-bit sRGB values (3 bytes a texel), decoded on lookup by a table of the 256
+    /// linear values — the very values decoding at load would give.
+    Srgb8(Vec<u8>, &'static [f32; 256]),
+    /// Linear floats (12 bytes a texel): 16-bit and floating-point files.
+    Linear(Vec<f32>),
+}
+
+/// The linear value of each 8-bit sRGB value.
+fn srgb_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|b| srgb_to_linear(b as u8)))
 }
 
 impl Image {
+    /// An image of 8-bit sRGB values, `3 · width · height` of them.
+    pub fn srgb8(width: u32, height: u32, rgb: Vec<u8>) -> Image {
+        assert_eq!(rgb.len(), 3 * width as usize * height as usize);
+        Image {
+            width,
+            height,
+            texels: Texels::Srgb8(rgb, srgb_table()),
+        }
+    }
+
+    /// An image of linear values, `3 · width · height` of them.
+    pub fn linear(width: u32, height: u32, rgb: Vec<f32>) -> Image {
+        assert_eq!(rgb.len(), 3 * width as usize * height as usize);
+        Image {
+            width,
+            height,
+            texels: Texels::Linear(rgb),
+        }
+    }
+
+    /// An image of linear colours, row by row.
+    pub fn from_colors(width: u32, height: u32, colors: &[Color]) -> Image {
+        Image::linear(width, height, colors.iter().flat_map(|c| c.to_array()).collect())
+    }
+
+    /// Bytes the texels take: what a texture costs in memory.
+    pub fn memory_bytes(&self) -> usize {
+        match &self.texels {
+            Texels::Srgb8(v, _) => v.len(),
+            Texels::Linear(v) => v.len() * 4,
+        }
+    }
+
+    /// Texel `i` (row by row) as linear RGB.
+    #[inline]
+    pub fn texel_at(&self, i: usize) -> Color {
+        match &self.texels {
+            Texels::Srgb8(v, table) => {
+                let t = &v[3 * i..3 * i + 3];
+                Color::new(table[t[0] as usize], table[t[1] as usize], table[t[2] as usize])
+            }
+            Texels::Linear(v) => Color::new(v[3 * i], v[3 * i + 1], v[3 * i + 2]),
+        }
+    }
+
+    #[inline]
     fn texel(&self, x: i64, y: i64) -> Color {
         let (w, h) = (self.width as i64, self.height as i64);
-        self.texels[(y.rem_euclid(h) * w + x.rem_euclid(w)) as usize]
+        self.texel_at((y.rem_euclid(h) * w + x.rem_euclid(w)) as usize)
     }
 
     /// Bilinear filtering at image coordinates (`x`, `y`) in texels (texel centres at
@@ -37,7 +99,10 @@ impl Image {
 
     /// The largest channel value of any texel (in absolute value).
     pub fn max_channel(&self) -> f32 {
-        self.texels.iter().map(|c| c.abs().max_element()).fold(0.0, f32::max)
+        match &self.texels {
+            Texels::Srgb8(v, table) => v.iter().map(|&b| table[b as usize]).fold(0.0, f32::max),
+            Texels::Linear(v) => v.iter().map(|x| x.abs()).fold(0.0, f32::max),
+        }
     }
 
     /// The image at texture coordinates `uv` ((0, 0) bottom left, wrapping).
@@ -148,14 +213,11 @@ mod tests {
     use super::*;
 
     fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> Color) -> Image {
-        Image {
-            width: w,
-            height: h,
-            texels: (0..h)
-                .flat_map(|y| (0..w).map(move |x| (x, y)))
-                .map(|(x, y)| f(x, y))
-                .collect(),
-        }
+        let colors: Vec<Color> = (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect();
+        Image::from_colors(w, h, &colors)
     }
 
     #[test]
@@ -205,6 +267,18 @@ mod tests {
         assert_eq!((down.y, down.z), (0.0, 2.0));
         // −z is the image centre (u = 0.5: between columns 1 and 2).
         assert!((env.radiance(-Vec3A::Z).x - 3.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn eight_bit_texels_read_as_their_decoded_values() {
+        let img = Image::srgb8(2, 1, vec![0, 128, 255, 188, 1, 2]);
+        assert_eq!(img.texel_at(0), Color::new(0.0, srgb_to_linear(128), 1.0));
+        assert_eq!(
+            img.texel_at(1),
+            Color::new(srgb_to_linear(188), srgb_to_linear(1), srgb_to_linear(2))
+        );
+        assert_eq!(img.memory_bytes(), 6);
+        assert_eq!(img.max_channel(), 1.0);
     }
 
     #[test]

@@ -20,6 +20,7 @@ use super::tessellation::{surface_mesh, View};
 use super::to_f32;
 use crate::desc::{SceneDesc, ShapeKind};
 use crate::diag::Diagnostics;
+use crate::resources::Resources;
 
 /// The scene's primitives, and the vertex normals their `trinormal` triangles index.
 pub struct Primitives {
@@ -31,10 +32,16 @@ pub struct Primitives {
 type Object = Option<(Arc<Geometry>, Aabb)>;
 
 /// The scene's primitives (objects built on the way).
-pub fn primitives(desc: &SceneDesc, materials: &mut Materials, view: &View, diags: &mut Diagnostics) -> Primitives {
+pub fn primitives(
+    desc: &SceneDesc,
+    materials: &mut Materials,
+    view: &View,
+    res: &mut Resources,
+    diags: &mut Diagnostics,
+) -> Primitives {
     let objects: Vec<Object> = (0..desc.objects.len() as u32)
         .map(|o| {
-            let p = shapes(desc, Some(o), &[], materials, view, diags);
+            let p = shapes(desc, Some(o), &[], materials, view, res, diags);
             if p.primitives.is_empty() {
                 return None;
             }
@@ -45,7 +52,7 @@ pub fn primitives(desc: &SceneDesc, materials: &mut Materials, view: &View, diag
             ))
         })
         .collect();
-    shapes(desc, None, &objects, materials, view, diags)
+    shapes(desc, None, &objects, materials, view, res, diags)
 }
 
 /// The primitives of the scene (`object` `None`) or of one object.
@@ -55,6 +62,7 @@ fn shapes(
     objects: &[Object],
     materials: &mut Materials,
     view: &View,
+    res: &mut Resources,
     diags: &mut Diagnostics,
 ) -> Primitives {
     let mut out = Primitives {
@@ -100,7 +108,7 @@ fn shapes(
             }
             ShapeKind::Surface { index } => {
                 let surface = &desc.surfaces[index as usize];
-                let Some(mesh) = surface_mesh(desc, s, surface, materials, view, diags) else {
+                let Some(mesh) = surface_mesh(desc, s, surface, materials, view, res, diags) else {
                     continue;
                 };
                 Shape::Mesh(MeshShape::new(mesh, view.accel))

@@ -12,6 +12,7 @@ use super::to_f32;
 use crate::desc::{MaterialDesc, SceneDesc, TextureSource};
 use crate::diag::{Diagnostics, Loc};
 use crate::mesh_file::MeshMaterial;
+use crate::resources::Resources;
 use crate::texture_file::load_image;
 
 /// The scene's materials and textures, which meshes add to as they are built.
@@ -25,12 +26,12 @@ pub struct Materials {
 }
 
 impl Materials {
-    pub fn new(desc: &SceneDesc, diags: &mut Diagnostics) -> Materials {
+    pub fn new(desc: &SceneDesc, res: &mut Resources, diags: &mut Diagnostics) -> Materials {
         let textures = desc
             .textures
             .iter()
             .map(|t| match &t.source {
-                TextureSource::Image(file) => match load_image(&file.value) {
+                TextureSource::Image(file) => match load_image(&file.value, res) {
                     Ok(img) => Texture::Image(img),
                     Err(e) => {
                         diags.error(file.loc, format!("texture: {}: {e}", file.value.display()));
@@ -64,6 +65,7 @@ impl Materials {
         library: &[MeshMaterial],
         mesh_dir: &Path,
         loc: Loc,
+        res: &mut Resources,
         diags: &mut Diagnostics,
     ) -> Option<Vec<u32>> {
         let mut ids = Vec::with_capacity(library.len());
@@ -87,7 +89,7 @@ impl Materials {
                 let name = format!("map_Kd:{}", path.display());
                 let index = match self.names.iter().position(|n| *n == name) {
                     Some(i) => i,
-                    None => match load_image(&path) {
+                    None => match load_image(&path, res) {
                         Ok(img) => {
                             self.textures.push(Texture::Image(img));
                             self.names.push(name);
@@ -137,9 +139,9 @@ fn material(m: &MaterialDesc) -> Material {
 }
 
 /// `envmap file [intensity]`, read.
-pub fn environment(desc: &SceneDesc, diags: &mut Diagnostics) -> Option<EnvironmentMap> {
+pub fn environment(desc: &SceneDesc, res: &mut Resources, diags: &mut Diagnostics) -> Option<EnvironmentMap> {
     let env = &desc.environment.as_ref()?.value;
-    match load_image(&env.file.value) {
+    match load_image(&env.file.value, res) {
         Ok(image) => Some(EnvironmentMap {
             image,
             intensity: env.intensity as f32,

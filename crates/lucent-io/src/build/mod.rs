@@ -26,6 +26,7 @@ use lucent_core::scene::{Scene, SceneParts};
 
 use crate::desc::SceneDesc;
 use crate::diag::Diagnostics;
+use crate::resources::Resources;
 
 pub use settings::{Work, UNBOUNDED_DEPTH_CAP};
 
@@ -66,30 +67,36 @@ impl Built {
     }
 }
 
-/// Builds the scene, or returns `None` after adding errors to `diags`.
-pub fn build(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) -> Option<Built> {
+/// Builds the scene, or returns `None` after adding errors to `diags`. Every file read is
+/// recorded in `inputs`.
+pub fn build(desc: &SceneDesc, options: &BuildOptions, res: &mut Resources, diags: &mut Diagnostics) -> Option<Built> {
     let first = diags.items.len();
-    let built = build_parts(desc, options, diags);
+    let built = build_parts(desc, options, res, diags);
     // The build runs by concern; its messages are shown in the order of the file.
     diags.items[first..].sort_by_key(|d| (d.loc.file, d.loc.line, d.loc.col));
     built.filter(|_| !diags.has_errors())
 }
 
-fn build_parts(desc: &SceneDesc, options: &BuildOptions, diags: &mut Diagnostics) -> Option<Built> {
+fn build_parts(
+    desc: &SceneDesc,
+    options: &BuildOptions,
+    res: &mut Resources,
+    diags: &mut Diagnostics,
+) -> Option<Built> {
     let mut integrator = settings::integrator(desc, diags);
     let (Some(size), Some(_)) = (&desc.size, &desc.camera) else {
         return None; // the parser has reported it
     };
     let (width, height) = size.value;
     let camera = camera::camera(desc, diags);
-    let mut materials = materials::Materials::new(desc, diags);
-    let environment = materials::environment(desc, diags);
+    let mut materials = materials::Materials::new(desc, res, diags);
+    let environment = materials::environment(desc, res, diags);
     let view = tessellation::View {
         camera: desc.camera.as_ref()?.value,
         height,
         accel: options.accel,
     };
-    let mut geometry = geometry::primitives(desc, &mut materials, &view, diags);
+    let mut geometry = geometry::primitives(desc, &mut materials, &view, res, diags);
     let lights = lights::lights(desc, &mut geometry.primitives, &mut materials.materials, diags);
     let camera = camera?;
     if diags.has_errors() {

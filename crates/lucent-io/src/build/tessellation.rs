@@ -21,8 +21,9 @@ use crate::desc::{
     SurfaceRecipe,
 };
 use crate::diag::Diagnostics;
-use crate::files::io_reason;
 use crate::mesh_file::{load_mesh, load_polygons, LoadedMesh, NO_MATERIAL};
+use crate::resources::input::MAX_SMALL_FILE_BYTES;
+use crate::resources::{read_input, Resources};
 
 /// The largest mesh subdivision may make.
 const MAX_SUBDIVIDED_TRIANGLES: u64 = 1 << 25;
@@ -45,6 +46,7 @@ pub fn surface_mesh(
     surface: &SurfaceDesc,
     materials: &mut Materials,
     view: &View,
+    res: &mut Resources,
     diags: &mut Diagnostics,
 ) -> Option<TriangleMesh> {
     let t = &desc.transforms[shape.transform as usize];
@@ -66,7 +68,7 @@ pub fn surface_mesh(
             return (!mesh.indices.is_empty()).then_some(mesh);
         }
     };
-    let mut mesh = object_mesh(desc, shape, &surface.recipe, materials, diags)?;
+    let mut mesh = object_mesh(desc, shape, &surface.recipe, materials, res, diags)?;
     if let Some(d) = &surface.displacement {
         mesh = displaced(&mesh, d, materials)
             .map_err(|e| diags.error(shape.loc, format!("{command}: displacementmap: {e}")))
@@ -93,12 +95,13 @@ fn object_mesh(
     shape: &ShapeDesc,
     recipe: &SurfaceRecipe,
     materials: &mut Materials,
+    res: &mut Resources,
     diags: &mut Diagnostics,
 ) -> Option<TriangleMesh> {
     match recipe {
         SurfaceRecipe::MeshFile { file } => {
             let path = &file.value;
-            let loaded = load_mesh(path)
+            let loaded = load_mesh(path, res)
                 .map_err(|e| diags.error(file.loc, format!("mesh: {}: {e}", path.display())))
                 .ok()?;
             for w in &loaded.warnings {
@@ -109,7 +112,7 @@ fn object_mesh(
                 // Faces with an MTL material take it; the others the captured material.
                 let base = &desc.materials[shape.material as usize];
                 let mesh_dir = path.parent().unwrap_or(std::path::Path::new("."));
-                let ids = materials.add_library(base, &library, mesh_dir, file.loc, diags)?;
+                let ids = materials.add_library(base, &library, mesh_dir, file.loc, res, diags)?;
                 for m in &mut mesh.materials {
                     *m = if *m == NO_MATERIAL {
                         shape.material
@@ -122,7 +125,7 @@ fn object_mesh(
         }
         SurfaceRecipe::Subdivision { scheme, levels, file } => {
             let path = &file.value;
-            let control = load_polygons(path)
+            let control = load_polygons(path, res)
                 .map_err(|e| diags.error(file.loc, format!("subdivmesh: {}: {e}", path.display())))
                 .ok()?;
             // Loop refines the fan triangulation, four triangles for one per level;
@@ -154,9 +157,9 @@ fn object_mesh(
         }
         SurfaceRecipe::BezierPatches { file, divisions } => {
             let path = &file.value;
-            let bytes = std::fs::read(path)
+            let bytes = read_input(path, MAX_SMALL_FILE_BYTES, &mut res.inputs)
                 .map_err(|e| {
-                    let msg = format!("bezierpatches: cannot read '{}': {}", path.display(), io_reason(&e));
+                    let msg = format!("bezierpatches: cannot read '{}': {e}", path.display());
                     diags.error(file.loc, msg)
                 })
                 .ok()?;

@@ -34,7 +34,8 @@ pub use commands::command_names;
 
 use crate::desc::SceneDesc;
 use crate::diag::{Diagnostics, Loc};
-use crate::files::io_reason;
+use crate::resources::input::MAX_SCENE_BYTES;
+use crate::resources::{read_input, Resources};
 use parser::Parser;
 
 /// Images larger than this many pixels are refused.
@@ -46,9 +47,10 @@ pub struct ParseOptions {
     pub strict: bool,
 }
 
-/// Reads and parses a scene file. A file that cannot be read is an error at `path:1:1`.
-pub fn parse_file(path: &Path, options: ParseOptions) -> (SceneDesc, Diagnostics) {
-    match std::fs::read(path) {
+/// Reads and parses a scene file (a regular file of at most [`MAX_SCENE_BYTES`]),
+/// recorded in `res`. A file that cannot be read is an error at `path:1:1`.
+pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (SceneDesc, Diagnostics) {
+    match read_input(path, MAX_SCENE_BYTES, &mut res.inputs) {
         Ok(bytes) => parse_bytes(&path.display().to_string(), &bytes, options),
         Err(e) => {
             let mut desc = SceneDesc::default();
@@ -61,7 +63,7 @@ pub fn parse_file(path: &Path, options: ParseOptions) -> (SceneDesc, Diagnostics
                     col: 1,
                     len: 0,
                 },
-                format!("cannot read scene file: {}", io_reason(&e)),
+                format!("cannot read scene file: {e}"),
             );
             (desc, diags)
         }

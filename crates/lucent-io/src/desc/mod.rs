@@ -154,4 +154,22 @@ impl SceneDesc {
     pub fn light_stratify(&self) -> bool {
         self.light_stratify.as_ref().is_some_and(|s| s.value)
     }
+
+    /// The files the description names (textures, mesh and patch files, the environment
+    /// map), resolved against the scene's folder. (MTL libraries and their images are
+    /// named by the mesh files.)
+    pub fn named_files(&self) -> Vec<&std::path::Path> {
+        let textures = self.textures.iter().filter_map(|t| match &t.source {
+            TextureSource::Image(f) => Some(f.value.as_path()),
+            TextureSource::Checker { .. } => None,
+        });
+        let surfaces = self.surfaces.iter().filter_map(|s| match &s.recipe {
+            SurfaceRecipe::MeshFile { file }
+            | SurfaceRecipe::Subdivision { file, .. }
+            | SurfaceRecipe::BezierPatches { file, .. } => Some(file.value.as_path()),
+            SurfaceRecipe::Nurbs(_) => None,
+        });
+        let env = self.environment.iter().map(|e| e.value.file.value.as_path());
+        textures.chain(surfaces).chain(env).collect()
+    }
 }

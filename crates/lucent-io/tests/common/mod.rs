@@ -45,7 +45,14 @@ pub fn render_scene(
     threads: usize,
 ) -> (lucent_core::film::Film, f32) {
     use lucent_io::session::{Renderer, Session, SessionOptions};
-    let mut session = Session::parse_text(scene, text.as_bytes(), SessionOptions { strict: false, accel });
+    let mut session = Session::parse_text(
+        scene,
+        text.as_bytes(),
+        SessionOptions {
+            accel,
+            ..SessionOptions::default()
+        },
+    );
     session.build();
     let built = session
         .built

@@ -15,8 +15,10 @@ use lucent_core::accel::{AccelKind, Accelerator};
 use lucent_core::geometry::mesh::TriangleMesh;
 use lucent_core::math::Vec3A;
 use lucent_core::ray::{PreparedRay, Ray};
-use lucent_io::image::write_file_atomically;
 use lucent_io::obj::load_obj;
+use lucent_io::resources::budget::Budget;
+use lucent_io::resources::input::MAX_MESH_BYTES;
+use lucent_io::resources::{read_input, OutputTarget, Resources};
 use rayon::prelude::*;
 
 use crate::EXIT_BAD_INPUT;
@@ -47,7 +49,8 @@ const RECORD: usize = 32;
 const MISS: u32 = u32::MAX;
 
 fn read_rays(path: &std::path::Path) -> Result<Vec<Ray>, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: cannot read ray file: {e}", path.display()))?;
+    let bytes = read_input(path, MAX_MESH_BYTES, &mut Resources::new(u64::MAX).inputs)
+        .map_err(|e| format!("{}: cannot read ray file: {e}", path.display()))?;
     if bytes.len() % RECORD != 0 {
         return Err(format!(
             "{}: {} bytes is not a whole number of 32-byte ray records",
@@ -104,10 +107,12 @@ pub fn run(args: &RaysBenchArgs) -> u8 {
 
 fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     let kind: AccelKind = args.accel.parse()?;
-    if let Some(out) = &args.hits {
-        lucent_io::image::check_writable(out).map_err(|e| e.to_string())?;
-    }
-    let mesh = load_obj(&args.mesh)
+    let target = match &args.hits {
+        Some(out) => Some(OutputTarget::resolve(out).map_err(|e| format!("cannot write {}: {e}", out.display()))?),
+        None => None,
+    };
+    let mut res = Resources::new(Budget::machine_default());
+    let mesh = load_obj(&args.mesh, &mut res)
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?
         .mesh;
     let rays = read_rays(&args.rays)?;
@@ -152,12 +157,17 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         .filter(|&&(t, prim)| if args.occluded { t == 0.0 } else { prim != MISS })
         .count();
 
-    if let Some(out) = &args.hits {
+    if let (Some(target), Some(out)) = (&target, &args.hits) {
         let bytes: Vec<u8> = answers
             .iter()
             .flat_map(|&(t, prim)| t.to_le_bytes().into_iter().chain(prim.to_le_bytes()))
             .collect();
-        write_file_atomically(out, &bytes).map_err(|e| e.to_string())?;
+        target
+            .check_not_input(&res.inputs)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        target
+            .write(&bytes)
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     }
     println!(
         "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} tris={} trace_s={trace_s:.4}",

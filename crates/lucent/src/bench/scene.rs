@@ -29,7 +29,10 @@ pub struct SceneBenchArgs {
 
 pub fn run(args: &SceneBenchArgs) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
-    let options = SessionOptions { strict: false, accel };
+    let options = SessionOptions {
+        accel,
+        ..SessionOptions::default()
+    };
     let session = Session::open(&args.scene, options);
     report(&session.diags, &session.desc.sources, false);
     let Some(built) = &session.built else {

@@ -1,0 +1,193 @@
+//! Reading the files a run needs — the scene, meshes, MTL libraries, patch files,
+//! textures, environment maps — only if they are regular files of a bounded size: a
+//! FIFO would block the run forever, `/dev/zero` or `/dev/urandom` would grow its memory
+//! until the machine stops it. A file is opened without blocking (so a FIFO cannot hang
+//! the open), then its kind and size are checked on the open handle (so nothing can be
+//! swapped in between), and it is read no further than its limit. Every file read is
+//! recorded, so that an output can refuse to overwrite one of the run's inputs.
+
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use super::io_reason;
+
+/// The largest scene file lucent reads.
+pub const MAX_SCENE_BYTES: u64 = 1 << 30;
+/// The largest mesh file (OBJ or PLY).
+pub const MAX_MESH_BYTES: u64 = 4 << 30;
+/// The largest MTL library or Bézier patch file.
+pub const MAX_SMALL_FILE_BYTES: u64 = 64 << 20;
+/// The largest image file (texture or environment map), compressed.
+pub const MAX_IMAGE_BYTES: u64 = 1 << 30;
+
+/// Which file a path names: its device and inode, the same for every path (and hard
+/// link) to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FileId {
+    dev: u64,
+    ino: u64,
+}
+
+impl FileId {
+    pub fn of(meta: &std::fs::Metadata) -> FileId {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            FileId {
+                dev: meta.dev(),
+                ino: meta.ino(),
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            let _ = meta;
+            FileId { dev: 0, ino: 0 }
+        }
+    }
+}
+
+/// The files a run has read.
+#[derive(Clone, Debug, Default)]
+pub struct Inputs {
+    files: Vec<(FileId, PathBuf)>,
+}
+
+impl Inputs {
+    pub fn record(&mut self, id: FileId, path: &Path) {
+        if !self.files.iter().any(|(f, _)| *f == id) {
+            self.files.push((id, path.to_path_buf()));
+        }
+    }
+
+    /// The path by which the run read the file `id`, if it did.
+    pub fn find(&self, id: FileId) -> Option<&Path> {
+        self.files.iter().find(|(f, _)| *f == id).map(|(_, p)| p.as_path())
+    }
+
+    pub fn paths(&self) -> impl Iterator<Item = &Path> {
+        self.files.iter().map(|(_, p)| p.as_path())
+    }
+}
+
+/// Opens `path` for reading if it is a regular file of at most `limit` bytes; records it
+/// in `inputs`. Returns the file and its size.
+pub fn open_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<(File, u64), String> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        // Opening a FIFO would otherwise wait for a writer; on a regular file the flag
+        // changes nothing.
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path).map_err(|e| io_reason(&e))?;
+    let meta = file.metadata().map_err(|e| io_reason(&e))?;
+    if !meta.is_file() {
+        return Err(format!("not a regular file ({})", kind(&meta)));
+    }
+    if meta.len() > limit {
+        return Err(format!(
+            "the file is {}, more than the {} lucent reads",
+            bytes(meta.len()),
+            bytes(limit)
+        ));
+    }
+    inputs.record(FileId::of(&meta), path);
+    Ok((file, meta.len()))
+}
+
+/// The whole of a regular file of at most `limit` bytes (see [`open_input`]).
+pub fn read_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<Vec<u8>, String> {
+    let (file, size) = open_input(path, limit, inputs)?;
+    let mut bytes = Vec::new();
+    bytes
+        .try_reserve_exact(size as usize)
+        .map_err(|_| format!("no memory for the file's {}", self::bytes(size)))?;
+    // A file that grows while it is read stops at its limit.
+    file.take(limit).read_to_end(&mut bytes).map_err(|e| io_reason(&e))?;
+    Ok(bytes)
+}
+
+/// What kind of file system object `meta` describes, in words.
+pub fn kind(meta: &std::fs::Metadata) -> &'static str {
+    let t = meta.file_type();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_symlink() {
+        "a symbolic link"
+    } else if t.is_file() {
+        "a regular file"
+    } else {
+        "not a file"
+    }
+}
+
+/// A byte count for people: "512 kB", "3.2 GB".
+pub fn bytes(n: u64) -> String {
+    let n = n as f64;
+    if n < 1e3 {
+        format!("{n} bytes")
+    } else if n < 1e6 {
+        format!("{:.0} kB", n / 1e3)
+    } else if n < 1e9 {
+        format!("{:.0} MB", n / 1e6)
+    } else {
+        format!("{:.1} GB", n / 1e9)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_regular_files_within_their_limit_are_read() {
+        let dir = std::env::temp_dir().join(format!("lucent-input-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut inputs = Inputs::default();
+        let f = dir.join("a.txt");
+        std::fs::write(&f, b"hello").unwrap();
+        assert_eq!(read_input(&f, 5, &mut inputs).unwrap(), b"hello");
+        assert!(read_input(&f, 4, &mut inputs)
+            .unwrap_err()
+            .contains("more than the 4 bytes"));
+        assert!(read_input(&dir, 100, &mut inputs).unwrap_err().contains("a directory"));
+        assert!(read_input(Path::new("/dev/zero"), 100, &mut inputs)
+            .unwrap_err()
+            .contains("character device"));
+        assert_eq!(
+            read_input(&dir.join("none"), 100, &mut inputs).unwrap_err(),
+            "no such file"
+        );
+        let id = FileId::of(&std::fs::metadata(&f).unwrap());
+        assert_eq!(inputs.find(id), Some(f.as_path()));
+        #[cfg(unix)]
+        {
+            // A FIFO with no writer: refused at once instead of waiting forever.
+            let fifo = dir.join("fifo");
+            let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+            // SAFETY: a valid NUL-terminated path.
+            assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+            assert!(read_input(&fifo, 100, &mut inputs).unwrap_err().contains("a FIFO"));
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

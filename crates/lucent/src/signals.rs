@@ -1,0 +1,51 @@
+//! Ctrl-C and SIGTERM. The first asks the render to stop: the render loop looks at the
+//! flag between pixels and between samples, and the run ends with exit code 130 (143 for
+//! SIGTERM) without writing an image; should a single sample take longer, the run ends
+//! anyway a second later. A second signal ends the run at once. Every way out removes
+//! the temporary file of an output being written.
+
+use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
+use std::time::Duration;
+
+use lucent_io::resources::output::remove_temporary_files;
+use signal_hook::consts::{SIGINT, SIGTERM};
+
+static CANCEL: AtomicBool = AtomicBool::new(false);
+static SIGNAL: AtomicI32 = AtomicI32::new(0);
+
+/// Set once a signal has asked the run to stop.
+pub fn cancel_flag() -> &'static AtomicBool {
+    &CANCEL
+}
+
+/// The exit code of a run a signal stopped: 128 + the signal's number.
+pub fn exit_code() -> u8 {
+    (128 + SIGNAL.load(Ordering::Relaxed).clamp(0, 127)) as u8
+}
+
+/// Starts listening for SIGINT and SIGTERM (once per process).
+pub fn install() {
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+        return; // Without the handler the default applies: the signal ends the run.
+    };
+    std::thread::spawn(move || {
+        for (count, sig) in signals.forever().enumerate() {
+            SIGNAL.store(sig, Ordering::Relaxed);
+            CANCEL.store(true, Ordering::Relaxed);
+            if count > 0 {
+                stop_now();
+            }
+            // The run stops cleanly within a second, or it is stopped.
+            std::thread::spawn(|| {
+                std::thread::sleep(Duration::from_secs(1));
+                stop_now();
+            });
+        }
+    });
+}
+
+fn stop_now() -> ! {
+    remove_temporary_files();
+    eprintln!("\nlucent: interrupted; nothing written");
+    std::process::exit(exit_code() as i32)
+}
