@@ -122,6 +122,12 @@ fn levels_for(mesh: &TriangleMesh, detail: Detail) -> u32 {
     levels
 }
 
+/// How many triangles [`displace`] makes of `mesh` (so that their memory can be weighed
+/// before they are made).
+pub fn refined_triangles(mesh: &TriangleMesh, field: &impl HeightField) -> usize {
+    mesh.indices.len() << (2 * levels_for(mesh, field.detail()))
+}
+
 /// The mesh refined and displaced by the height field along its normals (computed from
 /// the faces where the mesh has none), with normals recomputed from the displaced faces.
 pub fn displace(mesh: &TriangleMesh, field: &impl HeightField) -> Result<TriangleMesh, String> {

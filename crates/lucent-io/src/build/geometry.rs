@@ -22,6 +22,10 @@ use crate::desc::{SceneDesc, ShapeKind};
 use crate::diag::Diagnostics;
 use crate::resources::Resources;
 
+/// Memory a shape given in the scene file costs once built: its primitive (176 bytes)
+/// and its share of the structure and of the build's temporaries.
+const BYTES_PER_SHAPE: u64 = 256;
+
 /// The scene's primitives, and the vertex normals their `trinormal` triangles index.
 pub struct Primitives {
     pub primitives: Vec<Primitive>,
@@ -69,7 +73,16 @@ fn shapes(
         primitives: Vec::new(),
         vertex_normals: Vec::new(),
     };
-    for s in desc.shapes.iter().filter(|s| s.object == object) {
+    let shapes = desc.shapes.iter().filter(|s| s.object == object);
+    let count = shapes.clone().count() as u64;
+    if let Err(e) = res
+        .budget
+        .take(count.saturating_mul(BYTES_PER_SHAPE), &format!("{count} shapes"))
+    {
+        diags.error(desc.end, e);
+        return out;
+    }
+    for s in shapes {
         let t = &desc.transforms[s.transform as usize];
         let name = command_name(&s.kind);
         let shape = match s.kind {

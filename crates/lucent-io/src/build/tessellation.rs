@@ -9,7 +9,7 @@ use glam::{DVec3, DVec4, Vec3};
 use lucent_core::accel::AccelKind;
 use lucent_core::geometry::mesh::TriangleMesh;
 use lucent_core::shading::texture::Displacement;
-use lucent_core::tessellate::displacement::displace;
+use lucent_core::tessellate::displacement::{displace, refined_triangles};
 use lucent_core::tessellate::grid::grid_mesh;
 use lucent_core::tessellate::nurbs::NurbsSurface;
 use lucent_core::tessellate::subdivision::{self, Scheme};
@@ -22,6 +22,7 @@ use crate::desc::{
 };
 use crate::diag::Diagnostics;
 use crate::mesh_file::{load_mesh, load_polygons, LoadedMesh, NO_MATERIAL};
+use crate::resources::budget::BYTES_PER_TRIANGLE;
 use crate::resources::input::MAX_SMALL_FILE_BYTES;
 use crate::resources::{read_input, Resources};
 
@@ -55,13 +56,12 @@ pub fn surface_mesh(
         SurfaceRecipe::Subdivision { .. } => "subdivmesh",
         SurfaceRecipe::BezierPatches { .. } => "bezierpatches",
         SurfaceRecipe::Nurbs(nurbs) => {
-            let mut mesh = nurbs_mesh(&nurbs_surface(nurbs), t, view);
+            let surf = nurbs_surface(nurbs);
+            let (nu, nv) = nurbs_segments(&surf, t, view);
+            take_triangles(res, 2 * nu as u64 * nv as u64, shape, "nurbs", diags)?;
+            let mut mesh = nurbs_mesh(&surf, t, nu, nv);
             if let Some(d) = &surface.displacement {
-                mesh = displaced(&mesh, d, materials)
-                    .map_err(|e| {
-                        diags.error(shape.loc, format!("nurbs: displacementmap: {e}"));
-                    })
-                    .ok()?;
+                mesh = displaced(&mesh, d, materials, res, shape, "nurbs", diags)?;
                 mesh.remove_degenerate();
             }
             mesh.material = shape.material;
@@ -70,9 +70,7 @@ pub fn surface_mesh(
     };
     let mut mesh = object_mesh(desc, shape, &surface.recipe, materials, res, diags)?;
     if let Some(d) = &surface.displacement {
-        mesh = displaced(&mesh, d, materials)
-            .map_err(|e| diags.error(shape.loc, format!("{command}: displacementmap: {e}")))
-            .ok()?;
+        mesh = displaced(&mesh, d, materials, res, shape, command, diags)?;
     }
     let removed = mesh.remove_degenerate();
     if removed > 0 && command == "mesh" {
@@ -89,6 +87,22 @@ pub fn surface_mesh(
     (!mesh.indices.is_empty()).then_some(mesh)
 }
 
+/// Takes the memory of `n` triangles (with their structure) from the budget, or reports
+/// at the shape's command that it cannot.
+fn take_triangles(
+    res: &mut Resources,
+    n: u64,
+    shape: &ShapeDesc,
+    command: &str,
+    diags: &mut Diagnostics,
+) -> Option<()> {
+    let what = format!("{command}: a surface of {n} triangles");
+    res.budget
+        .take(n.saturating_mul(BYTES_PER_TRIANGLE), &what)
+        .map_err(|e| diags.error(shape.loc, e))
+        .ok()
+}
+
 /// The object-space mesh of a mesh file, subdivision surface or patch file.
 fn object_mesh(
     desc: &SceneDesc,
@@ -101,9 +115,18 @@ fn object_mesh(
     match recipe {
         SurfaceRecipe::MeshFile { file } => {
             let path = &file.value;
+            // Reading takes about eight bytes for each byte of the file; the mesh, once
+            // read, its triangles' share.
+            let reading = std::fs::metadata(path).map_or(0, |m| m.len()).saturating_mul(8);
+            res.budget
+                .take(reading, &format!("mesh: reading {}", path.display()))
+                .map_err(|e| diags.error(file.loc, e))
+                .ok()?;
             let loaded = load_mesh(path, res)
                 .map_err(|e| diags.error(file.loc, format!("mesh: {}: {e}", path.display())))
                 .ok()?;
+            res.budget.give_back(reading);
+            take_triangles(res, loaded.mesh.indices.len() as u64, shape, "mesh", diags)?;
             for w in &loaded.warnings {
                 diags.warning(file.loc, format!("mesh: {}: {w}", path.display()));
             }
@@ -151,6 +174,7 @@ fn object_mesh(
                 );
                 return None;
             }
+            take_triangles(res, total, shape, "subdivmesh", diags)?;
             subdivision::subdivide(&control, scheme, levels.value)
                 .map_err(|e| diags.error(file.loc, format!("subdivmesh: {}: {e}", path.display())))
                 .ok()
@@ -175,6 +199,8 @@ fn object_mesh(
                 })
                 .ok()?;
             let d = *divisions as usize;
+            let triangles = patches.patches.len() as u64 * 2 * (d * d) as u64;
+            take_triangles(res, triangles, shape, "bezierpatches", diags)?;
             let mut mesh = TriangleMesh::default();
             for patch in &patches.patches {
                 let grid: Vec<(Vec3, Vec3)> = lucent_core::tessellate::bezier::tessellate(patch, *divisions)
@@ -189,13 +215,25 @@ fn object_mesh(
     }
 }
 
-/// The mesh displaced by `scale × luminance` of the description's texture.
-fn displaced(mesh: &TriangleMesh, d: &DisplacementDesc, materials: &Materials) -> Result<TriangleMesh, String> {
+/// The mesh displaced by `scale × luminance` of the description's texture, its refined
+/// triangles taken from the budget; `None` after an error at the shape's command.
+fn displaced(
+    mesh: &TriangleMesh,
+    d: &DisplacementDesc,
+    materials: &Materials,
+    res: &mut Resources,
+    shape: &ShapeDesc,
+    command: &str,
+    diags: &mut Diagnostics,
+) -> Option<TriangleMesh> {
     let field = Displacement {
         texture: materials.texture(d.texture),
         scale: d.scale as f32,
     };
+    take_triangles(res, refined_triangles(mesh, &field) as u64, shape, command, diags)?;
     displace(mesh, &field)
+        .map_err(|e| diags.error(shape.loc, format!("{command}: displacementmap: {e}")))
+        .ok()
 }
 
 /// A mesh moved to world space by `t`, with `material` where its triangles have none of
@@ -234,10 +272,9 @@ fn nurbs_surface(n: &NurbsDesc) -> NurbsSurface {
     }
 }
 
-/// Tessellates a NURBS surface finely enough that no chord strays more than a quarter of
-/// a pixel from the surface where it is nearest to the camera, with normals from the
-/// exact derivatives, in world space.
-fn nurbs_mesh(surface: &NurbsSurface, t: &Transform, view: &View) -> TriangleMesh {
+/// How finely to tessellate a NURBS surface: no chord may stray more than a quarter of a
+/// pixel from the surface where it is nearest to the camera.
+fn nurbs_segments(surface: &NurbsSurface, t: &Transform, view: &View) -> (usize, usize) {
     let camera = &view.camera;
     // With positive weights the surface lies in the hull of its control points.
     let corners: Vec<DVec3> = surface.points.iter().map(|p| t.point(p.truncate() / p.w)).collect();
@@ -263,7 +300,12 @@ fn nurbs_mesh(surface: &NurbsSurface, t: &Transform, view: &View) -> TriangleMes
         .max(m.z_axis.length())
         .max(1e-300);
     let (nu, nv) = surface.segments_for(0.25 * pixel / stretch);
-    let (nu, nv) = (nu.min(MAX_NURBS_SEGMENTS), nv.min(MAX_NURBS_SEGMENTS));
+    (nu.min(MAX_NURBS_SEGMENTS), nv.min(MAX_NURBS_SEGMENTS))
+}
+
+/// A NURBS surface as a world-space grid of `nu × nv` quads, with normals from the exact
+/// derivatives.
+fn nurbs_mesh(surface: &NurbsSurface, t: &Transform, nu: usize, nv: usize) -> TriangleMesh {
     let grid: Vec<(Vec3, Vec3)> = surface
         .tessellate(nu, nv)
         .into_iter()

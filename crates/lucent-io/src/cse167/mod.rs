@@ -34,7 +34,7 @@ pub use commands::command_names;
 
 use crate::desc::SceneDesc;
 use crate::diag::{Diagnostics, Loc};
-use crate::resources::input::MAX_SCENE_BYTES;
+use crate::resources::input::{bytes as bytes_text, MAX_SCENE_BYTES};
 use crate::resources::{read_input, Resources};
 use parser::Parser;
 
@@ -50,7 +50,12 @@ pub struct ParseOptions {
 /// Reads and parses a scene file (a regular file of at most [`MAX_SCENE_BYTES`]),
 /// recorded in `res`. A file that cannot be read is an error at `path:1:1`.
 pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (SceneDesc, Diagnostics) {
-    match read_input(path, MAX_SCENE_BYTES, &mut res.inputs) {
+    let read = read_input(path, MAX_SCENE_BYTES, &mut res.inputs).and_then(|bytes| {
+        // The description takes about eight bytes for each byte of text.
+        let what = format!("the scene file of {}", bytes_text(bytes.len() as u64));
+        res.budget.take(bytes.len() as u64 * 8, &what).map(|_| bytes)
+    });
+    match read {
         Ok(bytes) => parse_bytes(&path.display().to_string(), &bytes, options),
         Err(e) => {
             let mut desc = SceneDesc::default();
