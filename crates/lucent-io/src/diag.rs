@@ -69,26 +69,47 @@ pub struct Diagnostic {
 
 /// Stop reporting after this many errors: a binary file would otherwise print one per line.
 pub const MAX_ERRORS: usize = 50;
+/// And after this many warnings (or notes): 200,000 lines of a misspelt command say the
+/// same thing 200,000 times.
+pub const MAX_WARNINGS: usize = 100;
+/// A message longer than this (it quotes a ten-megabyte token, say) is cut.
+pub const MAX_MESSAGE: usize = 1000;
 
-/// The diagnostics of one parse and build.
+/// The diagnostics of one parse and build. Counting them costs nothing, whatever their
+/// number.
 #[derive(Clone, Debug, Default)]
 pub struct Diagnostics {
     pub items: Vec<Diagnostic>,
     /// Errors not recorded because `MAX_ERRORS` was reached.
     pub suppressed_errors: usize,
+    /// Warnings and notes not recorded because `MAX_WARNINGS` was reached.
+    pub suppressed_warnings: usize,
+    /// How many of `items` are errors, warnings and notes (by [`Severity`]).
+    counts: [usize; 3],
 }
 
 impl Diagnostics {
     pub fn push(&mut self, severity: Severity, loc: Loc, message: impl Into<String>) {
-        if severity == Severity::Error && self.count(Severity::Error) >= MAX_ERRORS {
+        let recorded = self.count(severity);
+        if severity == Severity::Error && recorded >= MAX_ERRORS {
             self.suppressed_errors += 1;
             return;
         }
-        self.items.push(Diagnostic {
-            severity,
-            loc,
-            message: message.into(),
-        });
+        if severity != Severity::Error && recorded >= MAX_WARNINGS {
+            self.suppressed_warnings += 1;
+            return;
+        }
+        let mut message = message.into();
+        if message.len() > MAX_MESSAGE {
+            let mut cut = MAX_MESSAGE;
+            while !message.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            message.truncate(cut);
+            message.push('…');
+        }
+        self.counts[severity as usize] += 1;
+        self.items.push(Diagnostic { severity, loc, message });
     }
 
     pub fn error(&mut self, loc: Loc, message: impl Into<String>) {
@@ -103,8 +124,19 @@ impl Diagnostics {
         self.push(Severity::Note, loc, message)
     }
 
+    /// Whether a diagnostic of this severity would be recorded now (rather than only
+    /// counted): what it costs to word one need not be paid otherwise.
+    pub fn will_record(&self, severity: Severity) -> bool {
+        let cap = if severity == Severity::Error {
+            MAX_ERRORS
+        } else {
+            MAX_WARNINGS
+        };
+        self.count(severity) < cap
+    }
+
     pub fn count(&self, severity: Severity) -> usize {
-        self.items.iter().filter(|d| d.severity == severity).count()
+        self.counts[severity as usize]
     }
 
     pub fn has_errors(&self) -> bool {
@@ -124,7 +156,23 @@ impl Diagnostics {
         if self.suppressed_errors > 0 {
             let _ = writeln!(out, "error: {} more errors not shown", self.suppressed_errors);
         }
+        if self.suppressed_warnings > 0 {
+            let _ = writeln!(out, "warning: {} more warnings not shown", self.suppressed_warnings);
+        }
         out
+    }
+}
+
+/// How much of a line a diagnostic shows: up to this many characters.
+const SHOWN_CHARS: usize = 120;
+
+/// The first character and the number of characters of a line to show so that the span
+/// starting at `col` (0-based) of `len` characters is in view.
+fn window(col: usize, len: usize) -> (usize, usize) {
+    if col + len.min(SHOWN_CHARS / 2) <= SHOWN_CHARS {
+        (0, SHOWN_CHARS)
+    } else {
+        (col - SHOWN_CHARS / 4, SHOWN_CHARS)
     }
 }
 
@@ -141,20 +189,33 @@ pub fn render_one(d: &Diagnostic, sources: &SourceMap) -> String {
     if let Some(text) = sources.line(d.loc) {
         let num = d.loc.line.to_string();
         let pad = " ".repeat(num.len());
+        // A long line is shown in a window around the span (the column stays the line's).
+        let col = d.loc.col.saturating_sub(1) as usize;
+        let (first, shown_chars) = window(col, d.loc.len.max(1) as usize);
+        let cut_before = first > 0;
+        let chars: Vec<char> = text.chars().skip(first).take(shown_chars + 1).collect();
+        let cut_after = chars.len() > shown_chars;
+        let visible = &chars[..chars.len().min(shown_chars)];
         // Keep tabs so the caret lines up with the text above it.
-        let lead: String = text
-            .chars()
-            .take(d.loc.col.saturating_sub(1) as usize)
-            .map(|c| if c == '\t' { '\t' } else { ' ' })
+        let lead: String = visible
+            .iter()
+            .take(col - first)
+            .map(|&c| if c == '\t' { '\t' } else { ' ' })
             .collect();
-        let shown: String = text
-            .chars()
-            .map(|c| if c.is_control() && c != '\t' { '\u{fffd}' } else { c })
+        let body: String = visible
+            .iter()
+            .map(|&c| if c.is_control() && c != '\t' { '\u{fffd}' } else { c })
             .collect();
+        let (open, close, shift) = (
+            if cut_before { "…" } else { "" },
+            if cut_after { "…" } else { "" },
+            if cut_before { " " } else { "" },
+        );
+        let underline = (d.loc.len as usize).min(shown_chars.saturating_sub(col - first)).max(1);
         let _ = writeln!(
             out,
-            "{pad} |\n{num} | {shown}\n{pad} | {lead}^{}",
-            "~".repeat(d.loc.len.saturating_sub(1) as usize)
+            "{pad} |\n{num} | {open}{body}{close}\n{pad} | {shift}{lead}^{}",
+            "~".repeat(underline - 1)
         );
     }
     out
@@ -183,6 +244,54 @@ mod tests {
             "a.test:2:14: error: sphere: radius must be positive, got -1\n  |\n2 | sphere 0 0 0 -1\n  |              ^~\n"
         );
         assert!(d.has_errors());
+    }
+
+    #[test]
+    fn long_lines_and_messages_are_shown_in_part() {
+        let mut sources = SourceMap::default();
+        let line = format!("size 1 1 {}", "9".repeat(1_000_000));
+        let f = sources.add("a.test".into(), vec![line]);
+        let mut d = Diagnostics::default();
+        let token = Loc {
+            file: f,
+            line: 1,
+            col: 10,
+            len: 1_000_000,
+        };
+        d.error(token, format!("size: '{}' is out of range", "9".repeat(1_000_000)));
+        let text = d.render(&sources);
+        assert!(text.len() < 2 * MAX_MESSAGE + 400, "{} bytes", text.len());
+        assert!(text.starts_with("a.test:1:10: error: size: '999"), "{text}");
+        assert!(text.contains("| size 1 1 999") && text.contains("…\n"), "{text}");
+        // A span far along a long line is shown in a window around it.
+        let far = Loc {
+            file: f,
+            line: 1,
+            col: 500_000,
+            len: 3,
+        };
+        let mut d = Diagnostics::default();
+        d.error(far, "here");
+        let text = d.render(&sources);
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines[2].starts_with("1 | …9") && lines[3].contains("^~~"), "{text}");
+        // The caret stands under the span: "1 | …" then the quarter window before it.
+        let caret = lines[3].chars().position(|c| c == '^');
+        assert_eq!(caret, Some("1 | …".chars().count() + SHOWN_CHARS / 4), "{text}");
+    }
+
+    #[test]
+    fn warnings_are_capped_and_counted_in_constant_time() {
+        let mut d = Diagnostics::default();
+        for _ in 0..200_000 {
+            d.warning(Loc::default(), "unknown command 'x' ignored");
+        }
+        assert_eq!(d.count(Severity::Warning), MAX_WARNINGS);
+        assert_eq!(d.suppressed_warnings, 200_000 - MAX_WARNINGS);
+        assert!(!d.has_errors());
+        assert!(d
+            .render(&SourceMap::default())
+            .ends_with("warning: 199900 more warnings not shown\n"));
     }
 
     #[test]

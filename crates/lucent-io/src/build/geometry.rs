@@ -12,14 +12,14 @@ use lucent_core::geometry::instance::Instance;
 use lucent_core::geometry::mesh::MeshShape;
 use lucent_core::geometry::primitive::{Primitive, Shape};
 use lucent_core::geometry::Geometry;
-use lucent_core::math::Vec3A;
+use lucent_core::math::{Affine3A, Vec3A};
 use lucent_core::transform::Transform;
 
 use super::materials::Materials;
 use super::tessellation::{surface_mesh, View};
 use super::to_f32;
 use crate::desc::{SceneDesc, ShapeKind};
-use crate::diag::Diagnostics;
+use crate::diag::{Diagnostics, Loc};
 use crate::resources::Resources;
 
 /// Memory a shape given in the scene file costs once built: its primitive (176 bytes)
@@ -88,11 +88,10 @@ fn shapes(
         let shape = match s.kind {
             ShapeKind::Sphere { center, radius } => {
                 let m = t.m * DAffine3::from_translation(center) * DAffine3::from_scale(DVec3::splat(radius));
-                if Transform::new(m).is_none() {
-                    diags.error(s.loc, "sphere: the current transform is singular");
+                let Some(m) = single_precision(m, s.loc, name, diags) else {
                     continue;
-                }
-                Shape::Sphere(Sphere::new(Transform::to_f32(&m)))
+                };
+                Shape::Sphere(Sphere::new(m))
             }
             ShapeKind::Plane { .. }
             | ShapeKind::Box { .. }
@@ -100,11 +99,10 @@ fn shapes(
             | ShapeKind::Disk { .. }
             | ShapeKind::Cone { .. }
             | ShapeKind::Quadric { .. } => {
-                if Transform::new(t.m).is_none() {
-                    diags.error(s.loc, format!("{name}: the current transform is singular"));
+                let Some(m) = single_precision(t.m, s.loc, name, diags) else {
                     continue;
-                }
-                Shape::Analytic(Box::new(Analytic::new(Transform::to_f32(&t.m), analytic_kind(&s.kind))))
+                };
+                Shape::Analytic(Box::new(Analytic::new(m, analytic_kind(&s.kind))))
             }
             ShapeKind::Triangle { v } => {
                 let p = v.map(|i| to_f32(t.point(desc.vertices[i as usize])));
@@ -126,14 +124,15 @@ fn shapes(
                 };
                 Shape::Mesh(MeshShape::new(mesh, view.accel))
             }
-            ShapeKind::Instance { object } => match &objects[object as usize] {
-                Some((geometry, bounds)) => Shape::Instance(Box::new(Instance::new(
-                    geometry.clone(),
-                    *bounds,
-                    Transform::to_f32(&t.m),
-                ))),
-                None => continue, // an empty object (objectend warned)
-            },
+            ShapeKind::Instance { object } => {
+                let Some((geometry, bounds)) = &objects[object as usize] else {
+                    continue; // an empty object (objectend warned)
+                };
+                let Some(m) = single_precision(t.m, s.loc, name, diags) else {
+                    continue;
+                };
+                Shape::Instance(Box::new(Instance::new(geometry.clone(), *bounds, m)))
+            }
         };
         if let Shape::Triangle { p, normals } = &shape {
             let n = (p[1] - p[0]).cross(p[2] - p[0]);
@@ -148,6 +147,24 @@ fn shapes(
         out.primitives.push(Primitive::new(shape, s.material));
     }
     out
+}
+
+/// The transform `m` in single precision, which the shape inverts there: an error at the
+/// shape's command if it is singular in double precision or becomes so when rounded.
+fn single_precision(m: DAffine3, loc: Loc, name: &str, diags: &mut Diagnostics) -> Option<Affine3A> {
+    let single = Transform::new(m).map(|_| Transform::to_f32(&m));
+    let invertible = single.is_some_and(|f| {
+        let det = f.matrix3.determinant();
+        det.is_finite() && det != 0.0 && f.inverse().is_finite()
+    });
+    if !invertible {
+        diags.error(
+            loc,
+            format!("{name}: the current transform is singular (in single precision)"),
+        );
+        return None;
+    }
+    single
 }
 
 /// The command that made a shape of this kind (for messages).

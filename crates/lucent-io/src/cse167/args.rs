@@ -100,7 +100,15 @@ impl Parser {
             return None;
         }
         match tok.text.parse::<f64>() {
-            Ok(x) if x.is_finite() && x.abs() <= f32::MAX as f64 => Some(x),
+            Ok(x) if x.is_finite() && x.abs() <= f32::MAX as f64 && !underflows(x) => Some(x),
+            Ok(x) if underflows(x) => {
+                let msg = format!(
+                    "{}: {} is too small for single precision (nonzero numbers start at 1.2e-38)",
+                    c.name.text, tok.text
+                );
+                self.diags.error(loc, msg);
+                None
+            }
             _ => {
                 self.diags
                     .error(loc, format!("{}: {} is out of range", c.name.text, tok.text));
@@ -224,6 +232,12 @@ impl Parser {
     pub fn is_off(c: &Command) -> bool {
         c.args.len() == 1 && c.args[0].text == "off"
     }
+}
+
+/// Whether `x` is not zero but smaller than the smallest normal single-precision number:
+/// the renderer would see 0 (a radius of 1e-50 is no sphere) or lose its precision.
+fn underflows(x: f64) -> bool {
+    x != 0.0 && x.abs() < f32::MIN_POSITIVE as f64
 }
 
 /// "a, b or c".

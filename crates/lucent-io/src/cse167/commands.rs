@@ -8,6 +8,7 @@ use std::sync::OnceLock;
 
 use super::lexer::Command;
 use super::parser::Parser;
+use crate::diag::Severity;
 
 type Run = fn(&mut Parser, &Command);
 
@@ -125,7 +126,16 @@ impl Parser {
             Some(run) => run(self, c),
             None => {
                 let name = c.name.text;
-                let hint = suggestion(name).map_or(String::new(), |s| format!("; did you mean '{s}'?"));
+                let severity = if self.options.strict {
+                    Severity::Error
+                } else {
+                    Severity::Warning
+                };
+                let hint = if self.diags.will_record(severity) {
+                    suggestion(name).map_or(String::new(), |s| format!("; did you mean '{s}'?"))
+                } else {
+                    String::new()
+                };
                 let loc = self.loc(c.line, &c.name);
                 if self.options.strict {
                     self.diags.error(loc, format!("unknown command '{name}'{hint}"));
@@ -139,8 +149,12 @@ impl Parser {
 }
 
 /// The known command closest to a misspelt one: same letters ignoring case, or at most
-/// two edits away.
+/// two edits away. A name much longer than any command is no misspelling (and a
+/// ten-megabyte one would cost seconds to compare).
 fn suggestion(name: &str) -> Option<&'static str> {
+    if name.len() > 32 {
+        return None;
+    }
     let lower = name.to_lowercase();
     if let Some(c) = command_names().find(|c| c.to_lowercase() == lower) {
         return Some(c);
@@ -175,6 +189,7 @@ mod tests {
         assert_eq!(suggestion("pushtransform"), Some("pushTransform"));
         assert_eq!(suggestion("sphre"), Some("sphere"));
         assert_eq!(suggestion("xyzzyq"), None);
+        assert_eq!(suggestion(&"s".repeat(10_000_000)), None);
     }
 
     #[test]
