@@ -50,7 +50,8 @@ impl Sampler {
 /// the sample's two random numbers.
 pub fn stratified(i: u32, n: u32, u: f32, v: f32) -> (f32, f32) {
     let k = (n as f64).sqrt().round() as u32;
-    if k * k == n && n > 1 {
+    // (In u64: the root of a count near 2³² squares past u32.)
+    if k as u64 * k as u64 == n as u64 && n > 1 {
         let (cx, cy) = (i % k, i / k);
         ((cx as f32 + u) / k as f32, (cy as f32 + v) / k as f32)
     } else {
@@ -103,5 +104,7 @@ mod tests {
             cells[c] = true;
         }
         assert_eq!(stratified(2, 3, 0.25, 0.75), (0.25, 0.75));
+        // The largest count: not a square, and no overflow finding that out.
+        assert_eq!(stratified(7, u32::MAX, 0.5, 0.5), (0.5, 0.5));
     }
 }

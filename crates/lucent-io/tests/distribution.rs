@@ -174,3 +174,13 @@ fn the_seed_picks_the_noise_and_sample_ranges_take_their_samples() {
         );
     }
 }
+
+#[test]
+fn the_largest_sample_count_needs_no_table_of_its_samples() {
+    // With a lens, lens strata are shuffled by a table of spp entries: 2³² − 1 of them
+    // would be 16 GB for every pixel. Beyond 65,536 the lens samples are independent.
+    let text = "size 2 2\ncamera 0 0 5 0 0 0 0 1 0 45\nlens 0.1 5\nspp 4294967295\nambient 1 1 1\nsphere 0 0 0 1\n";
+    let film = common::render_job("t.test", text, |job| *job = job.probe(2, 3));
+    assert_eq!((film.width, film.height), (2, 2));
+    assert!(film.pixels.iter().all(|c| c.is_finite()));
+}

@@ -1,6 +1,7 @@
-//! The parser and build step never panic, whatever the input: random mutations of a
-//! valid scene (a deterministic fuzzer that runs with the tests; `fuzz/` has the
-//! coverage-guided one).
+//! The parser, the build step and the renderer never panic and never take long on small
+//! input, whatever it says: random mutations of a valid scene, and random scenes made of
+//! every command with random arguments, rendered (deterministic fuzzers that run with the
+//! tests; `fuzz/` has the coverage-guided ones).
 
 use lucent_io::cse167::{command_names, parse_bytes, ParseOptions};
 use lucent_io::session::{Session, SessionOptions};
@@ -98,4 +99,110 @@ fn random_mutations_never_panic() {
         }
         let _ = session.diags.render(&session.desc.sources);
     }
+}
+
+/// Arguments worth giving any command: numbers from the ordinary to the absurd, names,
+/// files that do not exist, devices.
+const ARGUMENTS: &[&str] = &[
+    "0",
+    "1",
+    "2",
+    "-1",
+    "0.5",
+    "3",
+    "16",
+    "100",
+    "1e-3",
+    "1e6",
+    "1e9",
+    "1e30",
+    "3e38",
+    "1e-37",
+    "2147483647",
+    "4294967295",
+    "-2147483648",
+    "on",
+    "off",
+    "mis",
+    "ggx",
+    "phong",
+    "brdf",
+    "cosine",
+    "hemisphere",
+    "loop",
+    "catmullclark",
+    "pathtracer",
+    "raytracer",
+    "t",
+    "thing",
+    "missing.obj",
+    "/dev/zero",
+    "x.png",
+];
+
+/// A random scene of `lines` commands from the command table after a valid `size` and
+/// `camera`. Each line is drawn until the parser takes it in the scene so far (up to 40
+/// tries, else the line is left out; one in fifty is kept whatever it says), so that most
+/// scenes get past the parser to the build and the renderer.
+fn random_scene(rng: &mut Rng, lines: usize) -> String {
+    let commands: Vec<&str> = command_names().collect();
+    let mut text = String::from("size 8 6\ncamera 0 0 5 0 0 0 0 1 0 45\n");
+    for _ in 0..lines {
+        let command = commands[rng.below(commands.len())];
+        let lenient = rng.below(50) == 0;
+        for _ in 0..40 {
+            let mut line = command.to_string();
+            for _ in 0..rng.below(13) {
+                line.push(' ');
+                line.push_str(ARGUMENTS[rng.below(ARGUMENTS.len())]);
+            }
+            let candidate = format!("{text}{line}\n");
+            let (_, diags) = parse_bytes("fuzz.test", candidate.as_bytes(), ParseOptions::default());
+            if lenient || !diags.has_errors() {
+                text = candidate;
+                break;
+            }
+        }
+    }
+    text
+}
+
+/// 600 random scenes, each parsed, built and rendered at its centre (four pixels, four
+/// samples at most, as the render fuzz target does), none allowed to panic or to take
+/// more than two seconds: the test profile is ~5 times slower than release, and a case
+/// that rendered the whole of what an absurd scene asks for (a billion samples, a
+/// maxdepth of 2^31 between mirrors) would take hours. Typical cases take milliseconds.
+#[test]
+fn random_scenes_render_quickly_and_never_panic() {
+    use lucent_core::accel::AccelKind;
+    use lucent_io::session::Renderer;
+    use std::time::{Duration, Instant};
+    let renderer = Renderer::new(Some(1)).unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let mut rng = Rng(0xfeed_5eed);
+    let mut rendered = 0;
+    for case in 0..600 {
+        let lines = 1 + rng.below(20);
+        let text = random_scene(&mut rng, lines);
+        let start = Instant::now();
+        let options = SessionOptions {
+            strict: false,
+            accel: AccelKind::List,
+            memory_limit: 64 << 20,
+        };
+        let mut session = Session::parse_text("fuzz.test", text.as_bytes(), options);
+        if session.build() {
+            let built = session.built.as_ref().unwrap();
+            let job = built.job().probe(2, 4);
+            let samples = job.pixels.pixels() as f64 * job.samples.len() as f64;
+            if built.work.rays_per_pixel / built.settings.spp as f64 * samples <= 200_000.0 {
+                renderer.render(built, &job, &|_| {}, &cancel).unwrap();
+                rendered += 1;
+            }
+        }
+        let _ = session.diags.render(&session.desc.sources);
+        let took = start.elapsed();
+        assert!(took < Duration::from_secs(2), "case {case} took {took:?}:\n{text}");
+    }
+    assert!(rendered > 100, "only {rendered} scenes got as far as rendering");
 }

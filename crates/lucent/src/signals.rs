@@ -1,13 +1,14 @@
 //! Ctrl-C and SIGTERM. The first asks the render to stop: the render loop looks at the
 //! flag between pixels and between samples, and the run ends with exit code 130 (143 for
 //! SIGTERM) without writing an image; should a single sample take longer, the run ends
-//! anyway a second later. A second signal ends the run at once. Every way out removes
-//! the temporary file of an output being written.
+//! anyway a second later. During the write of an output, and at a second signal, the run
+//! ends at once. Every way out removes the temporary file of an output being written, so
+//! an existing output is left as it was.
 
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::time::Duration;
 
-use lucent_io::resources::output::remove_temporary_files;
+use lucent_io::resources::output::{remove_temporary_files, writing};
 use signal_hook::consts::{SIGINT, SIGTERM};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -32,7 +33,7 @@ pub fn install() {
         for (count, sig) in signals.forever().enumerate() {
             SIGNAL.store(sig, Ordering::Relaxed);
             CANCEL.store(true, Ordering::Relaxed);
-            if count > 0 {
+            if count > 0 || writing() {
                 stop_now();
             }
             // The run stops cleanly within a second, or it is stopped.

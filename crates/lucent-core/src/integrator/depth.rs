@@ -47,7 +47,21 @@ pub struct DepthControl {
 impl DepthControl {
     pub fn for_scene(scene: &Scene) -> DepthControl {
         let radiance = scene_radiance(scene);
-        let reflectance = scene.materials.iter().map(bounce_factor).fold(0.0f32, f32::max);
+        // Materials share a handful of indices of refraction: each is weighed once.
+        let mut fresnel: Vec<(f32, f32)> = Vec::new();
+        let mut min_fresnel_of = |ior: f32| match fresnel.iter().find(|(n, _)| *n == ior) {
+            Some(&(_, f)) => f,
+            None => {
+                let f = min_fresnel(ior);
+                fresnel.push((ior, f));
+                f
+            }
+        };
+        let reflectance = scene
+            .materials
+            .iter()
+            .map(|m| bounce_factor(m, &mut min_fresnel_of))
+            .fold(0.0f32, f32::max);
         DepthControl::new(radiance, reflectance)
     }
 
@@ -88,7 +102,7 @@ impl DepthControl {
 /// branches it makes: `|S|` for a mirror; for glass, the reflected `|S|·F` plus the
 /// refracted `|Kt|·(1 − F)`, largest at one end of the Fresnel reflectance's range
 /// `[F_min, 1]`.
-fn bounce_factor(m: &Material) -> f32 {
+fn bounce_factor(m: &Material, min_fresnel: &mut impl FnMut(f32) -> f32) -> f32 {
     let s = m.specular.abs();
     if m.transparent == Color::ZERO {
         return s.max_element();
@@ -205,9 +219,9 @@ mod tests {
             ior,
             ..Material::default()
         };
-        let f = bounce_factor(&glass(1.5));
+        let f = bounce_factor(&glass(1.5), &mut min_fresnel);
         assert!((0.96..0.961).contains(&f), "{f}");
-        assert_eq!(bounce_factor(&glass(1.0)), 1.0);
+        assert_eq!(bounce_factor(&glass(1.0), &mut min_fresnel), 1.0);
         // Near Brewster's angle a very dense medium reflects less than head on.
         assert!(min_fresnel(10.0) < 0.99 * fresnel_dielectric(1.0, 1.0, 10.0));
     }

@@ -68,6 +68,24 @@ impl RenderJob {
         }
     }
 
+    /// A small part of the job: at most `side × side` pixels at the image's centre and
+    /// its first `samples` samples (for tests and fuzzing, which want what a scene makes
+    /// the renderer do without the time of a whole picture).
+    pub fn probe(&self, side: u32, samples: u32) -> RenderJob {
+        let (w, h) = (self.resolution.width, self.resolution.height);
+        let (x0, y0) = (w.saturating_sub(side) / 2, h.saturating_sub(side) / 2);
+        RenderJob {
+            pixels: PixelRect {
+                x0,
+                y0,
+                x1: (x0 + side).min(w),
+                y1: (y0 + side).min(h),
+            },
+            samples: self.samples.start..self.samples.end.min(self.samples.start + samples.max(1)),
+            ..self.clone()
+        }
+    }
+
     /// Why the job cannot be rendered, if it cannot: an empty or out-of-image
     /// rectangle, or a sample range that is empty or outside `0..spp`.
     pub fn check(&self) -> Result<(), String> {
@@ -121,5 +139,20 @@ mod tests {
         assert!(samples.check().unwrap_err().contains("within 0..16"));
         samples.samples = 3..3;
         assert!(samples.check().is_err(), "empty");
+        let probe = whole.probe(2, 4);
+        assert_eq!(
+            probe.pixels,
+            PixelRect {
+                x0: 19,
+                y0: 14,
+                x1: 21,
+                y1: 16
+            }
+        );
+        assert_eq!(probe.samples, 0..4);
+        assert!(RenderJob::whole(Resolution { width: 1, height: 1 }, 1)
+            .probe(2, 4)
+            .check()
+            .is_ok());
     }
 }

@@ -23,6 +23,9 @@ use crate::scene::Scene;
 use job::RenderJob;
 
 pub const TILE_SIZE: u32 = 16;
+/// The most samples per pixel whose lens positions are stratified (a table of this many
+/// entries per pixel, 256 kB).
+const MAX_LENS_STRATA: u32 = 1 << 16;
 /// Samples of one pixel between two looks at the cancel flag (so that even a pixel of a
 /// billion samples stops at once).
 const CANCEL_EVERY: u32 = 64;
@@ -123,10 +126,13 @@ fn render_tile(
     let mut bad_samples = 0;
     let n = job.spp.max(1);
     let taken = job.samples.len() as u32;
+    // Shuffled lens strata need a table of `spp` entries: beyond MAX_LENS_STRATA samples
+    // per pixel (where stratifying them no longer matters) lens samples are independent.
+    let shuffle_lens = scene.camera.has_lens() && n <= MAX_LENS_STRATA;
     let mut lens_strata: Vec<u32> = Vec::new();
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
-            if scene.camera.has_lens() {
+            if shuffle_lens {
                 lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
             }
             let mut sum = Color::ZERO;
@@ -143,11 +149,13 @@ fn render_tile(
                     let (u, v) = sampler.uniform2();
                     stratified(i, n, u, v)
                 };
-                let lens = if scene.camera.has_lens() {
+                let lens = if shuffle_lens {
                     // The lens strata in another order than the pixel's, so that where a
                     // sample falls in the pixel says nothing about where it leaves the lens.
                     let (u, v) = sampler.uniform2();
                     stratified(lens_strata[i as usize], n, u, v)
+                } else if scene.camera.has_lens() {
+                    sampler.uniform2()
                 } else {
                     (0.5, 0.5)
                 };

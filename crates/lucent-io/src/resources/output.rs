@@ -182,6 +182,11 @@ pub fn remove_temporary_files() {
     }
 }
 
+/// Whether an output is being written now (a temporary file exists).
+pub fn writing() -> bool {
+    TEMPORARY.try_lock().map_or(true, |list| !list.is_empty())
+}
+
 /// A temporary file beside its target, removed unless it is renamed over it.
 struct TemporaryFile {
     path: PathBuf,

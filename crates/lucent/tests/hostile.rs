@@ -1,0 +1,590 @@
+//! Hostile and careless input, end to end: nothing a scene or a file can do may crash
+//! lucent, hang it, exhaust the machine or overwrite what it must not. The scenes are in
+//! `tests/hostile/`; the large ones are made here. Every run has a watchdog, so a hang is
+//! a failure, not a stuck test.
+//!
+//! `LUCENT_TEST_BINARY=/path/to/lucent cargo test -p lucent --test hostile` runs these
+//! against another build (each of them fails on lucent before this hardening). None of
+//! them writes outside its own temporary folder, whatever the build under test does: the
+//! device nodes it writes to are its own copies.
+
+use std::fs;
+use std::io::{BufRead, BufReader, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn bin() -> PathBuf {
+    std::env::var_os("LUCENT_TEST_BINARY").map_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_lucent")), PathBuf::from)
+}
+
+/// A file of `tests/hostile/`.
+fn data(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hostile").join(name)
+}
+
+/// A fresh, empty directory for one test.
+fn workdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("lucent-hostile-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    d
+}
+
+struct Run {
+    /// `None` if the watchdog killed it (or a signal ended it).
+    code: Option<i32>,
+    stdout: Vec<u8>,
+    stderr: String,
+    took: Duration,
+}
+
+/// Runs lucent in `dir`, killed after `limit`.
+fn run(dir: &Path, args: &[&str], limit: Duration) -> Run {
+    let child = Command::new(bin())
+        .args(args)
+        .current_dir(dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run lucent");
+    finish(child, limit)
+}
+
+fn finish(mut child: Child, limit: Duration) -> Run {
+    let start = Instant::now();
+    // Drain the pipes while waiting, so a chatty child cannot block on them.
+    let mut out = child.stdout.take().unwrap();
+    let mut err = child.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut o = Vec::new();
+        out.read_to_end(&mut o).unwrap();
+        o
+    });
+    let err_reader = std::thread::spawn(move || {
+        let mut e = Vec::new();
+        err.read_to_end(&mut e).unwrap();
+        e
+    });
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break Some(s);
+        }
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            break None;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    Run {
+        code: status.and_then(|s| s.code()),
+        stdout: reader.join().unwrap(),
+        stderr: String::from_utf8_lossy(&err_reader.join().unwrap()).into_owned(),
+        took: start.elapsed(),
+    }
+}
+
+fn seconds(n: u64) -> Duration {
+    Duration::from_secs(n)
+}
+
+/// The ray count of a render's summary line (`…, 1234 rays, …`).
+fn rays(stderr: &str) -> u64 {
+    let part = stderr.split(" rays,").next().unwrap();
+    part.rsplit(' ').next().unwrap().parse().unwrap()
+}
+
+fn temporary_files(dir: &Path) -> Vec<String> {
+    fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with("lucent-tmp") || n.ends_with(".tmp"))
+        .collect()
+}
+
+fn mkfifo(path: &Path) {
+    let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+}
+
+// ---- 1. recursion a scene controls; adaptive depth control ----
+
+#[test]
+fn a_deep_glossy_ray_tree_renders_instead_of_overflowing_the_stack() {
+    let dir = workdir("deep");
+    for scene in ["deep_glossy.test", "glass_in_mirror.test"] {
+        let r = run(
+            &dir,
+            &["render", data(scene).to_str().unwrap(), "-o", "out.png", "-q"],
+            seconds(60),
+        );
+        assert_eq!(r.code, Some(0), "{scene}: {}", r.stderr);
+        assert!(dir.join("out.png").exists());
+    }
+}
+
+#[test]
+fn a_billion_bounces_in_a_mirror_sphere_cost_what_a_hundred_do() {
+    let dir = workdir("mirror");
+    let text = fs::read_to_string(data("mirror_sphere.test")).unwrap();
+    fs::write(
+        dir.join("hundred.test"),
+        text.replace("maxdepth 1000000000", "maxdepth 100"),
+    )
+    .unwrap();
+    let billion = run(
+        &dir,
+        &["render", data("mirror_sphere.test").to_str().unwrap(), "-o", "a.png"],
+        seconds(60),
+    );
+    let hundred = run(&dir, &["render", "hundred.test", "-o", "b.png"], seconds(60));
+    assert_eq!((billion.code, hundred.code), (Some(0), Some(0)), "{}", billion.stderr);
+    let (a, b) = (rays(&billion.stderr), rays(&hundred.stderr));
+    assert!(
+        a as f64 <= 1.1 * b as f64,
+        "{a} rays for maxdepth 1e9, {b} for maxdepth 100"
+    );
+    assert_eq!(
+        fs::read(dir.join("a.png")).unwrap(),
+        fs::read(dir.join("b.png")).unwrap()
+    );
+}
+
+// ---- 2. unbounded work ----
+
+#[test]
+fn absurd_work_is_estimated_and_warned_about() {
+    let dir = workdir("work");
+    for (scene, setting) in [
+        ("absurd_spp.test", "spp"),
+        ("absurd_lightsamples.test", "lightsamples"),
+        ("absurd_depth.test", "maxdepth"),
+    ] {
+        let r = run(&dir, &["check", data(scene).to_str().unwrap()], seconds(30));
+        assert_eq!(r.code, Some(0), "{scene}: {}", r.stderr);
+        let warning = format!("warning: {setting}: this render traces about ");
+        assert!(r.stderr.contains(&warning), "{scene}: {}", r.stderr);
+        assert!(
+            String::from_utf8_lossy(&r.stdout).contains("work:       about"),
+            "{scene}"
+        );
+    }
+}
+
+#[test]
+fn ctrl_c_stops_a_billion_samples_at_once() {
+    let dir = workdir("interrupt");
+    let mut child = Command::new(bin())
+        .args(["render", data("absurd_spp.test").to_str().unwrap(), "-o", "out.png"])
+        .current_dir(&dir)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Once the warning is out, the render is under way.
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("warning") {
+        line.clear();
+        assert!(err.read_line(&mut line).unwrap() > 0, "no warning");
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let start = Instant::now();
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let status = child.wait().unwrap();
+    assert!(start.elapsed() < seconds(3), "took {:?}", start.elapsed());
+    assert_eq!(status.code(), Some(130));
+    assert!(!dir.join("out.png").exists());
+}
+
+// ---- 3. outputs ----
+
+/// A character device node `name` in `dir` (major, minor), so that a broken build under
+/// test could only ever replace this copy, never the system's `/dev/null`; where nodes
+/// cannot be made (not root), the system's own, which such a user cannot replace.
+fn device(dir: &Path, name: &str, major: u32, minor: u32) -> PathBuf {
+    let path = dir.join(name);
+    let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    let made = unsafe { libc::mknod(c.as_ptr(), libc::S_IFCHR | 0o666, libc::makedev(major, minor)) } == 0;
+    if made {
+        path
+    } else {
+        Path::new("/dev").join(name)
+    }
+}
+
+#[test]
+fn devices_and_streams_are_written_never_replaced() {
+    use std::os::unix::fs::FileTypeExt;
+    let dir = workdir("devices");
+    let scene = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 1 1 3 1 1 1\ndiffuse 1 0 0\nsphere 0 0 0 1\n";
+    fs::write(dir.join("s.test"), scene).unwrap();
+    let s = "s.test";
+    let null = device(&dir, "null", 1, 3);
+    let full = device(&dir, "full", 1, 7);
+    let r = run(&dir, &["render", s, "-o", null.to_str().unwrap(), "-q"], seconds(30));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(fs::metadata(&null).unwrap().file_type().is_char_device());
+    let r = run(&dir, &["render", s, "-o", full.to_str().unwrap(), "-q"], seconds(30));
+    assert_eq!(r.code, Some(2));
+    assert!(r.stderr.contains("no space left on device"), "{}", r.stderr);
+    assert!(fs::metadata(&full).unwrap().file_type().is_char_device());
+    // Standard output, by name and through a link into /proc (as /dev/stdout is).
+    std::os::unix::fs::symlink("/proc/self/fd/1", dir.join("stdout")).unwrap();
+    for stdout in ["-", "stdout"] {
+        let r = run(&dir, &["render", s, "-o", stdout, "-q"], seconds(30));
+        assert_eq!(r.code, Some(0), "{}", r.stderr);
+        assert_eq!(&r.stdout[..8], b"\x89PNG\r\n\x1a\n", "{stdout}");
+        assert!(fs::symlink_metadata(dir.join("stdout"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
+    // A FIFO nobody reads: an error, not a hang.
+    mkfifo(&dir.join("fifo"));
+    let r = run(&dir, &["render", s, "-o", "fifo", "-q"], seconds(30));
+    assert_eq!(r.code, Some(2));
+    assert!(r.stderr.contains("nothing reads from it"), "{}", r.stderr);
+    assert!(fs::metadata(dir.join("fifo")).unwrap().file_type().is_fifo());
+    let r = run(&dir, &["render", s, "-o", ".", "-q"], seconds(30));
+    assert_eq!(r.code, Some(2));
+    assert!(temporary_files(&dir).is_empty());
+}
+
+#[test]
+fn links_are_written_through_and_long_names_work() {
+    let dir = workdir("links");
+    fs::write(
+        dir.join("s.test"),
+        "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\nsphere 0 0 0 1\n",
+    )
+    .unwrap();
+    fs::write(dir.join("real.png"), b"old").unwrap();
+    std::os::unix::fs::symlink("real.png", dir.join("link.png")).unwrap();
+    let r = run(&dir, &["render", "s.test", "-o", "link.png", "-q"], seconds(30));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(fs::symlink_metadata(dir.join("link.png"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert_eq!(&fs::read(dir.join("real.png")).unwrap()[..4], b"\x89PNG");
+    // A name of 255 bytes: the temporary name beside it would be longer.
+    let long = format!("{}.png", "x".repeat(251));
+    let r = run(&dir, &["render", "s.test", "-o", &long, "-q"], seconds(30));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(dir.join(&long).exists());
+    assert!(temporary_files(&dir).is_empty());
+}
+
+#[test]
+fn the_runs_own_inputs_are_never_overwritten() {
+    let dir = workdir("inputs");
+    image::RgbImage::from_raw(1, 1, vec![200, 100, 50])
+        .unwrap()
+        .save(dir.join("bricks.png"))
+        .unwrap();
+    let bricks = fs::read(dir.join("bricks.png")).unwrap();
+    let scene =
+        "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\ntexture b bricks.png\ndiffusemap b\ndiffuse 1 1 1\nsphere 0 0 0 1\n";
+    fs::write(dir.join("s.test"), scene).unwrap();
+    fs::write(dir.join("o.test"), format!("{scene}output bricks.png\n")).unwrap();
+    // The scene itself, and the scene's texture (by -o and by its own output command).
+    for args in [
+        ["render", "s.test", "-o", "s.test"],
+        ["render", "s.test", "-o", "bricks.png"],
+    ] {
+        let r = run(&dir, &args, seconds(30));
+        assert_eq!(r.code, Some(2), "{args:?}");
+        assert!(r.stderr.contains("it is one of this run's inputs"), "{}", r.stderr);
+    }
+    let r = run(&dir, &["render", "o.test", "-q"], seconds(30));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    // An image an OBJ's MTL library names (found only while building).
+    fs::write(dir.join("m.mtl"), "newmtl w\nKd 1 1 1\nmap_Kd bricks.png\n").unwrap();
+    fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl w\nf 1 2 3\n",
+    )
+    .unwrap();
+    fs::write(
+        dir.join("mesh.test"),
+        "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\nmesh m.obj\n",
+    )
+    .unwrap();
+    let r = run(&dir, &["render", "mesh.test", "-o", "bricks.png", "-q"], seconds(30));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert_eq!(fs::read(dir.join("bricks.png")).unwrap(), bricks);
+    assert_eq!(fs::read_to_string(dir.join("s.test")).unwrap(), scene);
+    assert!(temporary_files(&dir).is_empty());
+}
+
+#[test]
+fn an_interrupted_write_leaves_no_temporary_file() {
+    let dir = workdir("write");
+    // A 4096² float image: about 200 MB to write, time enough to interrupt it.
+    fs::write(dir.join("s.test"), "size 4096 4096\ncamera 0 0 5 0 0 0 0 1 0 45\n").unwrap();
+    for _attempt in 0..5 {
+        let _ = fs::remove_file(dir.join("big.exr"));
+        let child = Command::new(bin())
+            .args(["render", "s.test", "-o", "big.exr", "-q"])
+            .current_dir(&dir)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let pid = child.id() as i32;
+        let start = Instant::now();
+        let mut seen = false;
+        while start.elapsed() < seconds(60) && !seen {
+            seen = !temporary_files(&dir).is_empty();
+            if !seen {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+        }
+        if seen {
+            // SAFETY: signalling our own child.
+            unsafe { libc::kill(pid, libc::SIGINT) };
+        }
+        let r = finish(child, seconds(30));
+        if seen && r.code == Some(130) {
+            assert!(temporary_files(&dir).is_empty(), "{:?}", temporary_files(&dir));
+            assert!(!dir.join("big.exr").exists());
+            return;
+        }
+        assert!(temporary_files(&dir).is_empty());
+    }
+    panic!("the write was never caught in progress");
+}
+
+// ---- 4. inputs without end ----
+
+#[test]
+fn inputs_that_are_not_regular_files_are_refused_at_once() {
+    let dir = workdir("endless");
+    mkfifo(&dir.join("fifo"));
+    let head = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\n";
+    fs::write(dir.join("tex.test"), format!("{head}texture t /dev/urandom\n")).unwrap();
+    fs::write(dir.join("mesh.test"), format!("{head}mesh fifo.obj\n")).unwrap();
+    fs::write(dir.join("env.test"), format!("{head}envmap fifo\n")).unwrap();
+    fs::write(dir.join("patch.test"), format!("{head}bezierpatches /dev/zero\n")).unwrap();
+    std::os::unix::fs::symlink("fifo", dir.join("fifo.obj")).unwrap();
+    for (scene, message) in [
+        ("fifo", "cannot read scene file: not a regular file (a FIFO)"),
+        (
+            "/dev/zero",
+            "cannot read scene file: not a regular file (a character device)",
+        ),
+        ("tex.test", "not a regular file (a character device)"),
+        ("mesh.test", "not a regular file (a FIFO)"),
+        ("env.test", "not a regular file (a FIFO)"),
+        ("patch.test", "not a regular file (a character device)"),
+    ] {
+        let r = run(&dir, &["render", scene, "-o", "out.png"], seconds(20));
+        assert_eq!(r.code, Some(2), "{scene}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{scene}: {}", r.stderr);
+    }
+    // An MTL library that is a FIFO: the mesh keeps the current material, with a warning.
+    fs::write(
+        dir.join("m.obj"),
+        "mtllib fifo\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n",
+    )
+    .unwrap();
+    fs::write(dir.join("mtl.test"), format!("{head}mesh m.obj\n")).unwrap();
+    let r = run(&dir, &["render", "mtl.test", "-o", "out.png"], seconds(20));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(
+        r.stderr
+            .contains("cannot read the MTL material library (not a regular file (a FIFO))"),
+        "{}",
+        r.stderr
+    );
+}
+
+// ---- 5. memory ----
+
+/// A PNG whose header says 16384 × 16384 (its pixels are never read).
+fn forged_png(width: u32, height: u32) -> Vec<u8> {
+    fn chunk(out: &mut Vec<u8>, kind: &[u8], data: &[u8]) {
+        out.extend((data.len() as u32).to_be_bytes());
+        let mut crc_input = kind.to_vec();
+        crc_input.extend(data);
+        out.extend(&crc_input);
+        out.extend(crc32(&crc_input).to_be_bytes());
+    }
+    fn crc32(bytes: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in bytes {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
+            }
+        }
+        !c
+    }
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = Vec::new();
+    ihdr.extend(width.to_be_bytes());
+    ihdr.extend(height.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]); // 8-bit RGB
+    chunk(&mut png, b"IHDR", &ihdr);
+    chunk(&mut png, b"IDAT", &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01]);
+    chunk(&mut png, b"IEND", &[]);
+    png
+}
+
+#[test]
+fn textures_and_tessellations_are_held_to_the_budget_before_they_are_made() {
+    let dir = workdir("budget");
+    fs::write(dir.join("huge.png"), forged_png(16384, 16384)).unwrap();
+    let head = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\n";
+    fs::write(dir.join("tex.test"), format!("{head}texture a huge.png\n")).unwrap();
+    let r = run(&dir, &["check", "tex.test", "--memory-limit", "1G"], seconds(20));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("tex.test:3:11: error: texture: ")
+            && r.stderr.contains("the 16384 x 16384 image needs about 1.6 GB"),
+        "{}",
+        r.stderr
+    );
+    // One patch, 256 × 256 quads: 131,072 triangles, 19 MB each time.
+    let patch = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.bpt")).unwrap();
+    let one: Vec<&str> = patch.lines().collect();
+    // The file: the patch count, 32 patch lines, the point count, the points.
+    let single = format!("1\n{}\n{}\n", one[1], one[33..].join("\n"));
+    fs::write(dir.join("one.bpt"), single).unwrap();
+    let many: String = (0..8).map(|_| "bezierpatches one.bpt 256\n").collect();
+    fs::write(dir.join("patches.test"), format!("{head}{many}")).unwrap();
+    let r = run(&dir, &["check", "patches.test", "--memory-limit", "100M"], seconds(60));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(
+        r.stderr
+            .contains("patches.test:8:1: error: bezierpatches: a surface of 131072 triangles needs about 19 MB"),
+        "{}",
+        r.stderr
+    );
+    assert!(!r.stderr.contains(":7:1: error"), "the first five fit: {}", r.stderr);
+}
+
+#[test]
+fn an_allocation_that_fails_anyway_exits_with_code_2() {
+    let dir = workdir("oom");
+    let teapot = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.bpt");
+    fs::copy(teapot, dir.join("teapot.bpt")).unwrap();
+    fs::write(
+        dir.join("s.test"),
+        "size 8 8\ncamera 0 -8 3 0 0 1 0 0 1 45\nbezierpatches teapot.bpt 256\n",
+    )
+    .unwrap();
+    // 4.2 M triangles under a 300 MB address space, with a budget that lets it try.
+    let child = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 300000; exec {} render s.test -o out.png --memory-limit 10G",
+            bin().display()
+        ))
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let r = finish(child, seconds(120));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(
+        r.stderr.contains("lucent: error: out of memory: an allocation of "),
+        "{}",
+        r.stderr
+    );
+    assert!(!dir.join("out.png").exists());
+}
+
+// ---- 6. diagnostics ----
+
+#[test]
+fn diagnostics_stay_short_and_take_time_linear_in_the_input() {
+    let dir = workdir("diagnostics");
+    let head = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\n";
+    fs::write(
+        dir.join("unknown.test"),
+        format!("{head}{}", "frobnicate 1 2 3\n".repeat(200_000)),
+    )
+    .unwrap();
+    fs::write(dir.join("name.test"), format!("{head}{} 1\n", "x".repeat(10_000_000))).unwrap();
+    fs::write(
+        dir.join("line.test"),
+        format!("{head}sphere {}\n", "1 ".repeat(25_000_000)),
+    )
+    .unwrap();
+    for (scene, code, expect) in [
+        ("unknown.test", 0, "warning: 199900 more warnings not shown"),
+        ("name.test", 0, "unknown command 'xxxx"),
+        ("line.test", 2, "too many arguments on one line"),
+    ] {
+        let r = run(&dir, &["check", scene], seconds(60));
+        assert_eq!(r.code, Some(code), "{scene}: {}", &r.stderr[..r.stderr.len().min(2000)]);
+        assert!(
+            r.stderr.contains(expect),
+            "{scene}: {}",
+            &r.stderr[..r.stderr.len().min(2000)]
+        );
+        assert!(
+            r.stderr.len() < 40_000,
+            "{scene}: {} bytes of diagnostics",
+            r.stderr.len()
+        );
+        // Linear: seconds at most in the test build (was 115 s for 200,000 lines).
+        assert!(r.took < seconds(30), "{scene}: {:?}", r.took);
+    }
+}
+
+// ---- 7. values the docs call errors ----
+
+#[test]
+fn values_that_leave_single_precision_or_the_file_are_located_errors() {
+    let dir = workdir("values");
+    for (scene, message) in [
+        (
+            "tiny_radius.test",
+            "tiny_radius.test:3:14: error: sphere: 1e-50 is too small for single precision",
+        ),
+        (
+            "tiny_scale.test",
+            "tiny_scale.test:3:7: error: scale: 1e-50 is too small for single precision",
+        ),
+        (
+            "huge_scale.test",
+            "huge_scale.test:4:1: error: scale: the transform would leave single precision",
+        ),
+        ("nan_material.test", "nan_material.test:3:6: error: mesh: "),
+        (
+            "bad_texcoords.test",
+            "line 4: a face refers to texture coordinate 0, but the file has 0",
+        ),
+    ] {
+        let r = run(
+            &dir,
+            &["render", data(scene).to_str().unwrap(), "-o", "out.png"],
+            seconds(20),
+        );
+        assert_eq!(r.code, Some(2), "{scene}: {}", r.stderr);
+        assert!(r.stderr.contains(message), "{scene}: {}", r.stderr);
+    }
+    let r = run(
+        &dir,
+        &["render", data("nan_material.test").to_str().unwrap(), "-o", "out.png"],
+        seconds(20),
+    );
+    assert!(
+        r.stderr
+            .contains("material 'bad': Kd [NaN, 0.5, 0.5] is not three finite numbers"),
+        "{}",
+        r.stderr
+    );
+    image::RgbImage::new(2, 2).save(dir.join("a.png")).unwrap();
+    let r = run(&dir, &["diff", "a.png", "a.png", "--max-mae", "nan"], seconds(20));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    assert!(r.stderr.contains("'nan' is not a number ≥ 0"), "{}", r.stderr);
+    assert!(!dir.join("out.png").exists());
+}
