@@ -3,31 +3,23 @@
 //! counts, degenerate shapes), not only what it can make the parser do. Nothing may
 //! panic or overflow the stack. Run with `cargo +nightly fuzz run render_scene`.
 //!
-//! Capped in the harness: inputs of at most 8 kB, a 64 MB budget, the brute-force list,
-//! four pixels at most (the middle of the image), at most four samples of each, and no
-//! render whose estimated work exceeds 200,000 rays.
+//! Capped in the harness: `lucent_fuzz::built_scene`'s caps, four pixels at most (the
+//! middle of the image), at most four samples of each, and no render whose estimated
+//! work exceeds 200,000 rays.
 #![no_main]
 
 use std::sync::atomic::AtomicBool;
 
 use libfuzzer_sys::fuzz_target;
-use lucent_core::accel::AccelKind;
-use lucent_io::session::{Renderer, Session, SessionOptions};
+use lucent_io::session::Renderer;
 
 fuzz_target!(|data: &[u8]| {
-    if data.len() > 8192 {
+    let Some(session) = lucent_fuzz::built_scene(data) else {
         return;
-    }
-    let options = SessionOptions {
-        strict: false,
-        accel: AccelKind::List,
-        memory_limit: 64 << 20,
     };
-    let mut session = Session::parse_text("fuzz.test", data, options);
-    if !session.build() {
+    let Some(built) = &session.built else {
         return;
-    }
-    let built = session.built.as_ref().expect("built");
+    };
     let job = built.job().probe(2, 4);
     let samples = job.pixels.pixels() as f64 * job.samples.len() as f64;
     if built.work.rays_per_pixel / built.settings.spp as f64 * samples > 200_000.0 {

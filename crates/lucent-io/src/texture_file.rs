@@ -70,8 +70,7 @@ mod tests {
 
     #[test]
     fn eight_bit_images_are_decoded_from_srgb_and_float_images_kept() {
-        let dir = std::env::temp_dir().join(format!("lucent-tex-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::TestDir::new("tex");
         let mut res = Resources::new(u64::MAX);
         let png = dir.join("t.png");
         image::RgbImage::from_raw(2, 1, vec![255, 188, 0, 0, 0, 255])
@@ -99,6 +98,5 @@ mod tests {
         let mut small = Resources::new(10);
         let e = load_image(&png, &mut small).unwrap_err();
         assert!(e.contains("the 2 x 1 image needs about 12 bytes"), "{e}");
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -6,12 +6,13 @@ use std::process::{Command, Output};
 
 const SCENE: &str = "size 32 24\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 1 1 3 1 1 1\ndiffuse 0.6 0.3 0.2\nspecular 0.3 0.3 0.3\nsphere 0 0 0 1\nvertex -3 -1 -3\nvertex 3 -1 -3\nvertex 3 -1 3\ntri 0 2 1\n";
 
+mod common;
+
+use common::files_in;
+
 /// A fresh, empty directory for one test.
 fn workdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("lucent-cli-{}-{name}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
+    common::workdir("cli", name)
 }
 
 fn lucent(dir: &Path, args: &[&str]) -> Output {
@@ -24,15 +25,6 @@ fn lucent(dir: &Path, args: &[&str]) -> Output {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 #[test]

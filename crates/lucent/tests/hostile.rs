@@ -23,12 +23,11 @@ fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/hostile").join(name)
 }
 
+mod common;
+
 /// A fresh, empty directory for one test.
 fn workdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("lucent-hostile-{}-{name}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
+    common::workdir("hostile", name)
 }
 
 struct Run {
@@ -96,11 +95,17 @@ fn rays(stderr: &str) -> u64 {
 }
 
 fn temporary_files(dir: &Path) -> Vec<String> {
-    fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+    common::files_in(dir)
+        .into_iter()
         .filter(|n| n.ends_with("lucent-tmp") || n.ends_with(".tmp"))
         .collect()
+}
+
+/// Asserts that the run's messages say `text`.
+#[track_caller]
+fn says(r: &Run, text: &str) {
+    let shown = &r.stderr[..r.stderr.len().min(4000)];
+    assert!(r.stderr.contains(text), "expected «{text}» in:\n{shown}");
 }
 
 fn mkfifo(path: &Path) {
@@ -165,7 +170,7 @@ fn absurd_work_is_estimated_and_warned_about() {
         let r = run(&dir, &["check", data(scene).to_str().unwrap()], seconds(30));
         assert_eq!(r.code, Some(0), "{scene}: {}", r.stderr);
         let warning = format!("warning: {setting}: this render traces about ");
-        assert!(r.stderr.contains(&warning), "{scene}: {}", r.stderr);
+        says(&r, &warning);
         assert!(
             String::from_utf8_lossy(&r.stdout).contains("work:       about"),
             "{scene}"
@@ -230,7 +235,7 @@ fn devices_and_streams_are_written_never_replaced() {
     assert!(fs::metadata(&null).unwrap().file_type().is_char_device());
     let r = run(&dir, &["render", s, "-o", full.to_str().unwrap(), "-q"], seconds(30));
     assert_eq!(r.code, Some(2));
-    assert!(r.stderr.contains("no space left on device"), "{}", r.stderr);
+    says(&r, "no space left on device");
     assert!(fs::metadata(&full).unwrap().file_type().is_char_device());
     // Standard output, by name and through a link into /proc (as /dev/stdout is).
     std::os::unix::fs::symlink("/proc/self/fd/1", dir.join("stdout")).unwrap();
@@ -247,7 +252,7 @@ fn devices_and_streams_are_written_never_replaced() {
     mkfifo(&dir.join("fifo"));
     let r = run(&dir, &["render", s, "-o", "fifo", "-q"], seconds(30));
     assert_eq!(r.code, Some(2));
-    assert!(r.stderr.contains("nothing reads from it"), "{}", r.stderr);
+    says(&r, "nothing reads from it");
     assert!(fs::metadata(dir.join("fifo")).unwrap().file_type().is_fifo());
     let r = run(&dir, &["render", s, "-o", ".", "-q"], seconds(30));
     assert_eq!(r.code, Some(2));
@@ -298,7 +303,7 @@ fn the_runs_own_inputs_are_never_overwritten() {
     ] {
         let r = run(&dir, &args, seconds(30));
         assert_eq!(r.code, Some(2), "{args:?}");
-        assert!(r.stderr.contains("it is one of this run's inputs"), "{}", r.stderr);
+        says(&r, "it is one of this run's inputs");
     }
     let r = run(&dir, &["render", "o.test", "-q"], seconds(30));
     assert_eq!(r.code, Some(2), "{}", r.stderr);
@@ -384,7 +389,7 @@ fn inputs_that_are_not_regular_files_are_refused_at_once() {
     ] {
         let r = run(&dir, &["render", scene, "-o", "out.png"], seconds(20));
         assert_eq!(r.code, Some(2), "{scene}: {}", r.stderr);
-        assert!(r.stderr.contains(message), "{scene}: {}", r.stderr);
+        says(&r, message);
     }
     // An MTL library that is a FIFO: the mesh keeps the current material, with a warning.
     fs::write(
@@ -395,12 +400,7 @@ fn inputs_that_are_not_regular_files_are_refused_at_once() {
     fs::write(dir.join("mtl.test"), format!("{head}mesh m.obj\n")).unwrap();
     let r = run(&dir, &["render", "mtl.test", "-o", "out.png"], seconds(20));
     assert_eq!(r.code, Some(0), "{}", r.stderr);
-    assert!(
-        r.stderr
-            .contains("cannot read the MTL material library (not a regular file (a FIFO))"),
-        "{}",
-        r.stderr
-    );
+    says(&r, "cannot read the MTL material library (not a regular file (a FIFO))");
 }
 
 // ---- 5. memory ----
@@ -443,12 +443,8 @@ fn textures_and_tessellations_are_held_to_the_budget_before_they_are_made() {
     fs::write(dir.join("tex.test"), format!("{head}texture a huge.png\n")).unwrap();
     let r = run(&dir, &["check", "tex.test", "--memory-limit", "1G"], seconds(20));
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    assert!(
-        r.stderr.contains("tex.test:3:11: error: texture: ")
-            && r.stderr.contains("the 16384 x 16384 image needs about 1.6 GB"),
-        "{}",
-        r.stderr
-    );
+    says(&r, "tex.test:3:11: error: texture: ");
+    says(&r, "the 16384 x 16384 image needs about 1.6 GB");
     // One patch, 256 × 256 quads: 131,072 triangles, 19 MB each time.
     let patch = fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/teapot.bpt")).unwrap();
     let one: Vec<&str> = patch.lines().collect();
@@ -459,11 +455,9 @@ fn textures_and_tessellations_are_held_to_the_budget_before_they_are_made() {
     fs::write(dir.join("patches.test"), format!("{head}{many}")).unwrap();
     let r = run(&dir, &["check", "patches.test", "--memory-limit", "100M"], seconds(60));
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    assert!(
-        r.stderr
-            .contains("patches.test:8:1: error: bezierpatches: a surface of 131072 triangles needs about 19 MB"),
-        "{}",
-        r.stderr
+    says(
+        &r,
+        "patches.test:8:1: error: bezierpatches: a surface of 131072 triangles needs about 19 MB",
     );
     assert!(!r.stderr.contains(":7:1: error"), "the first five fit: {}", r.stderr);
 }
@@ -492,11 +486,7 @@ fn an_allocation_that_fails_anyway_exits_with_code_2() {
         .unwrap();
     let r = finish(child, seconds(120));
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    assert!(
-        r.stderr.contains("lucent: error: out of memory: an allocation of "),
-        "{}",
-        r.stderr
-    );
+    says(&r, "lucent: error: out of memory: an allocation of ");
     assert!(!dir.join("out.png").exists());
 }
 
@@ -524,11 +514,7 @@ fn diagnostics_stay_short_and_take_time_linear_in_the_input() {
     ] {
         let r = run(&dir, &["check", scene], seconds(60));
         assert_eq!(r.code, Some(code), "{scene}: {}", &r.stderr[..r.stderr.len().min(2000)]);
-        assert!(
-            r.stderr.contains(expect),
-            "{scene}: {}",
-            &r.stderr[..r.stderr.len().min(2000)]
-        );
+        says(&r, expect);
         assert!(
             r.stderr.len() < 40_000,
             "{scene}: {} bytes of diagnostics",
@@ -569,22 +555,17 @@ fn values_that_leave_single_precision_or_the_file_are_located_errors() {
             seconds(20),
         );
         assert_eq!(r.code, Some(2), "{scene}: {}", r.stderr);
-        assert!(r.stderr.contains(message), "{scene}: {}", r.stderr);
+        says(&r, message);
     }
     let r = run(
         &dir,
         &["render", data("nan_material.test").to_str().unwrap(), "-o", "out.png"],
         seconds(20),
     );
-    assert!(
-        r.stderr
-            .contains("material 'bad': Kd [NaN, 0.5, 0.5] is not three finite numbers"),
-        "{}",
-        r.stderr
-    );
+    says(&r, "material 'bad': Kd [NaN, 0.5, 0.5] is not three finite numbers");
     image::RgbImage::new(2, 2).save(dir.join("a.png")).unwrap();
     let r = run(&dir, &["diff", "a.png", "a.png", "--max-mae", "nan"], seconds(20));
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    assert!(r.stderr.contains("'nan' is not a number ≥ 0"), "{}", r.stderr);
+    says(&r, "'nan' is not a number ≥ 0");
     assert!(!dir.join("out.png").exists());
 }

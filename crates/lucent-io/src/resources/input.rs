@@ -160,8 +160,8 @@ mod tests {
 
     #[test]
     fn only_regular_files_within_their_limit_are_read() {
-        let dir = std::env::temp_dir().join(format!("lucent-input-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let test = crate::TestDir::new("input");
+        let dir = test.0.clone();
         let mut inputs = Inputs::default();
         let f = dir.join("a.txt");
         std::fs::write(&f, b"hello").unwrap();
@@ -188,6 +188,5 @@ mod tests {
             assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
             assert!(read_input(&fifo, 100, &mut inputs).unwrap_err().contains("a FIFO"));
         }
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -278,16 +278,10 @@ fn path_cstring(path: &Path) -> Option<CString> {
 mod tests {
     use super::*;
 
-    fn dir(name: &str) -> PathBuf {
-        let d = std::env::temp_dir().join(format!("lucent-out-{name}-{}", std::process::id()));
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
-    }
-
     #[test]
     fn files_are_replaced_whole_and_links_and_devices_are_kept() {
-        let d = dir("kinds");
+        let test = crate::TestDir::new("out-kinds");
+        let d = test.0.clone();
         let file = d.join("a.png");
         let target = OutputTarget::resolve(&file).unwrap();
         assert_eq!(target, OutputTarget::File(file.clone()));
@@ -317,22 +311,22 @@ mod tests {
             names.iter().all(|n| !n.to_string_lossy().contains("lucent-tmp")),
             "{names:?}"
         );
-        fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
     fn a_name_near_the_limit_gets_a_short_temporary_name() {
-        let d = dir("long");
+        let test = crate::TestDir::new("out-long");
+        let d = test.0.clone();
         let file = d.join(format!("{}.png", "x".repeat(NAME_MAX - 4)));
         let t = OutputTarget::resolve(&file).unwrap();
         t.write(b"ok").unwrap();
         assert_eq!(fs::read(&file).unwrap(), b"ok");
-        fs::remove_dir_all(&d).unwrap();
     }
 
     #[test]
     fn inputs_are_not_overwritten() {
-        let d = dir("inputs");
+        let test = crate::TestDir::new("out-inputs");
+        let d = test.0.clone();
         let scene = d.join("s.test");
         fs::write(&scene, "size 1 1").unwrap();
         let mut inputs = Inputs::default();
@@ -346,6 +340,5 @@ mod tests {
             .unwrap()
             .check_not_input(&inputs)
             .is_ok());
-        fs::remove_dir_all(&d).unwrap();
     }
 }
