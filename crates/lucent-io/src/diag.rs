@@ -82,8 +82,10 @@ pub struct Diagnostics {
     pub items: Vec<Diagnostic>,
     /// Errors not recorded because `MAX_ERRORS` was reached.
     pub suppressed_errors: usize,
-    /// Warnings and notes not recorded because `MAX_WARNINGS` was reached.
+    /// Warnings not recorded because `MAX_WARNINGS` were.
     pub suppressed_warnings: usize,
+    /// Notes not recorded because `MAX_WARNINGS` were.
+    pub suppressed_notes: usize,
     /// How many of `items` are errors, warnings and notes (by [`Severity`]).
     counts: [usize; 3],
 }
@@ -96,7 +98,10 @@ impl Diagnostics {
             return;
         }
         if severity != Severity::Error && recorded >= MAX_WARNINGS {
-            self.suppressed_warnings += 1;
+            match severity {
+                Severity::Note => self.suppressed_notes += 1,
+                _ => self.suppressed_warnings += 1,
+            }
             return;
         }
         let mut message = message.into();

@@ -17,6 +17,16 @@ const MAX_TEXELS: u64 = 1 << 28;
 
 /// Reads an image file as a texture, taking its memory from `res`'s budget.
 pub fn load_image(path: &Path, res: &mut Resources) -> Result<Image, String> {
+    // The file's bytes are held while it is decoded.
+    let file_size = std::fs::metadata(path).map_or(0, |m| m.len());
+    res.budget.take(file_size, "the image file")?;
+    let image = decode(path, res);
+    res.budget.give_back(file_size);
+    image
+}
+
+/// [`load_image`] once the file's own memory is taken.
+fn decode(path: &Path, res: &mut Resources) -> Result<Image, String> {
     let bytes = read_input(path, MAX_IMAGE_BYTES, &mut res.inputs).map_err(|e| format!("cannot open: {e}"))?;
     let decoder = ImageReader::new(Cursor::new(&bytes[..]))
         .with_guessed_format()
@@ -29,21 +39,17 @@ pub fn load_image(path: &Path, res: &mut Resources) -> Result<Image, String> {
         return Err(format!("unusable image size {width} x {height}"));
     }
     // Decoding makes the file's own pixels, then ours: 3 bytes a texel for 8-bit files,
-    // 12 for the others.
+    // 12 for the others, which pass through a 6-byte copy on the way.
     let decoded = decoder.total_bytes();
     let eight_bit = decoder.color_type().bytes_per_pixel() / decoder.color_type().channel_count().max(1) == 1;
     let kept = texels * if eight_bit { 3 } else { 12 };
+    let passing = if eight_bit { 0 } else { texels * 6 };
     let what = format!("the {width} x {height} image");
-    res.budget.take(decoded + kept, &what)?;
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(decoded.max(kept) + (1 << 20));
-    let mut decoder = decoder;
-    decoder
-        .set_limits(limits)
-        .map_err(|e| format!("cannot decode the image: {e}"))?;
-    let img = DynamicImage::from_decoder(decoder).map_err(|e| format!("cannot decode the image: {e}"))?;
-    // The decoded pixels are gone once ours are made.
-    res.budget.give_back(decoded);
+    res.budget.take(decoded + passing + kept, &what)?;
+    let img = decode_within(decoder, decoded.max(kept));
+    // The decoded pixels are gone once ours are made (or the decoding failed).
+    res.budget.give_back(decoded + passing);
+    let img = img.inspect_err(|_| res.budget.give_back(kept))?;
     use image::DynamicImage as D;
     let image = match img {
         D::ImageRgb32F(_) | D::ImageRgba32F(_) => Image::linear(width, height, img.into_rgb32f().into_raw()),
@@ -58,9 +64,20 @@ pub fn load_image(path: &Path, res: &mut Resources) -> Result<Image, String> {
         _ => Image::srgb8(width, height, img.into_rgb8().into_raw()),
     };
     if !image.max_channel().is_finite() {
+        res.budget.give_back(kept);
         return Err("the image holds values that are not finite numbers".into());
     }
     Ok(image)
+}
+
+/// The decoder's image, the decoder held to `bytes` (and a little) of memory.
+fn decode_within(mut decoder: impl ImageDecoder, bytes: u64) -> Result<DynamicImage, String> {
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(bytes + (1 << 20));
+    decoder
+        .set_limits(limits)
+        .map_err(|e| format!("cannot decode the image: {e}"))?;
+    DynamicImage::from_decoder(decoder).map_err(|e| format!("cannot decode the image: {e}"))
 }
 
 #[cfg(test)]
@@ -94,9 +111,15 @@ mod tests {
         std::fs::write(dir.join("bad.png"), b"not a png").unwrap();
         assert!(load_image(&dir.join("bad.png"), &mut res).is_err());
         assert!(load_image(&dir.join("missing.png"), &mut res).is_err());
-        // The budget is taken before decoding: 2 texels need 6 + 6 bytes.
-        let mut small = Resources::new(10);
+        // The budget is taken before decoding: the file's bytes, then 2 texels need 6 + 6
+        // bytes; all of it comes back when the image is refused.
+        let file = std::fs::metadata(&png).unwrap().len();
+        let mut small = Resources::new(file + 10);
         let e = load_image(&png, &mut small).unwrap_err();
         assert!(e.contains("the 2 x 1 image needs about 12 bytes"), "{e}");
+        assert_eq!(small.budget.used(), 0);
+        let mut enough = Resources::new(file + 12);
+        load_image(&png, &mut enough).unwrap();
+        assert_eq!(enough.budget.used(), 6, "what the texture keeps");
     }
 }

@@ -8,7 +8,7 @@
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::time::Duration;
 
-use lucent_io::resources::output::{remove_temporary_files, writing};
+use lucent_io::resources::output::{remove_temporary_files_and_exit, writing};
 use signal_hook::consts::{SIGINT, SIGTERM};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
@@ -45,8 +45,13 @@ pub fn install() {
     });
 }
 
+/// Ends the run: the message (written directly: a stalled or closed stderr must not
+/// keep the run alive), then the temporary files, then the process.
 fn stop_now() -> ! {
-    remove_temporary_files();
-    eprintln!("\nlucent: interrupted; nothing written");
-    std::process::exit(exit_code() as i32)
+    let msg = b"\nlucent: interrupted; nothing written\n";
+    // SAFETY: writing a static buffer to standard error; the result does not matter.
+    unsafe {
+        libc::write(2, msg.as_ptr().cast(), msg.len());
+    }
+    remove_temporary_files_and_exit(exit_code() as i32)
 }

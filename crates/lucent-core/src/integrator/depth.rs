@@ -5,23 +5,32 @@
 //! way) adds `w · I` to the pixel, where `I` is the radiance the branch's ray brings
 //! back: the local terms of its hit plus, weighted again, those of the branches after it.
 //! With `R` the largest local radiance of the scene and `ρ < 1` the largest factor a
-//! bounce multiplies a weight by, `|I| ≤ R (1 + ρ + ρ² + …) = R / (1 − ρ)`. A branch is
-//! dropped when `max|w| · R / (1 − ρ) < 2⁻¹²`:
+//! bounce multiplies a weight by, `|I| ≤ R (1 + ρ + ρ² + …) = R / (1 − ρ)`, so leaving
+//! the branch out changes the pixel by at most its *cost* `max|w| · R / (1 − ρ)`.
 //!
-//! - in an 8-bit image a channel moves by at most 2⁻¹² — a sixteenth of one step
-//!   (1/255) — so a pixel changes by one step at most, and only if its value lies within
-//!   2⁻¹² below a step boundary;
-//! - in a float image the value moves by less than 2⁻¹² — about 2⁻¹⁴ of a stop at a
-//!   value of 1 — below what any display of it can show.
+//! Each camera sample has an **error budget** `τ`: branches are left out only while the
+//! sum of their costs stays within it, so the whole sample — and so the pixel, their
+//! mean — moves by at most `τ` in every channel. Where the scene draws random numbers
+//! after the camera ray (quad-light samples, glossy directions), only branches after
+//! which nothing else is traced may go: a branch left out earlier would not draw its
+//! numbers, and every branch after it would get others. `τ` is what the 8-bit encoding cannot
+//! show: a change of at most 2⁻¹² after `gamma`, a sixteenth of one step (1/255), which
+//! moves a truncated value by one step at most and only when it lies within 2⁻¹² below a
+//! step. For `gamma g ≥ 1` the encoding `c^(1/g)` is steepest at black, so `τ = 2^(−12 g)`;
+//! for `g < 1` it is steepest at white, with slope `1/g`, so `τ = g · 2⁻¹²`. A float image
+//! moves by less than `τ ≤ 2⁻¹²`, invisible on any display.
 //!
 //! `ρ` is a mirror's `|specular|`; for glass, whose branches share what the Fresnel
 //! reflectance `F` splits, the larger of `|specular|` and `|specular|·F_min +
-//! |transparent|·(1 − F_min)` (F_min: the interface's least reflectance over all
-//! angles) — below 1 for clear glass of any index but 1. `R` counts, for every material, `|ambient| + |emission|` plus each light's greatest
-//! delivered colour times `|diffuse| · (brightest texel) + |specular|` (a point light at
-//! a hundredth of the scene's size, a quad light filling a hemisphere), and the radiance
-//! of quad lights and the environment seen directly. When some material reflects or
-//! transmits everything (`ρ ≥ 1`) no branch is ever negligible and `maxdepth` alone ends
+//! |transparent|·(1 − F_min)` (F_min: the interface's least reflectance over all angles) —
+//! below 1 for clear glass of any index but 1. `R` counts, for every material, `|ambient|
+//! + |emission|` plus each light's greatest delivered colour times `|diffuse| ·
+//! (brightest texel) + |specular|`, and the radiance of quad lights and the environment
+//! seen directly. Two lights deliver without bound near them, and `R` takes them where
+//! scenes have their surfaces: a point light whose attenuation falls with distance at a
+//! hundredth of the scene's size, a quad light as filling a hemisphere (its samples'
+//! mean; one sample close to the light can exceed it). When some material reflects or
+//! transmits everything (`ρ ≥ 1`) no branch is ever left out and `maxdepth` alone ends
 //! the tree.
 
 use crate::light::Light;
@@ -31,7 +40,7 @@ use crate::shading::material::Material;
 use crate::shading::optics::fresnel_dielectric;
 use crate::shading::texture::Texture;
 
-/// What a branch may add, at most, and still not be traced.
+/// What a sample may lose to left-out branches in a linear 8-bit encoding: 2⁻¹².
 pub const INVISIBLE: f32 = 1.0 / 4096.0;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,12 +49,20 @@ pub struct DepthControl {
     pub radiance: f32,
     /// `ρ`: the largest factor one bounce multiplies a branch's weight by.
     pub reflectance: f32,
+    /// `τ`: what a camera sample may lose to left-out branches.
+    pub budget: f32,
+    /// Only the last branches of a sample may be left out: the scene draws random numbers
+    /// after the camera ray (quad-light samples, glossy directions), and a left-out branch
+    /// would take its numbers away from every branch after it, changing them by more than
+    /// the budget.
+    pub tails_only: bool,
     /// `R / (1 − ρ)`, infinite when `ρ ≥ 1` (or the scene's radiance is unbounded).
     bound: f32,
 }
 
 impl DepthControl {
-    pub fn for_scene(scene: &Scene) -> DepthControl {
+    /// The control for `scene` whose image is encoded with `gamma`.
+    pub fn for_scene(scene: &Scene, gamma: f32) -> DepthControl {
         let radiance = scene_radiance(scene);
         // Materials share a handful of indices of refraction: each is weighed once.
         let mut fresnel: Vec<(f32, f32)> = Vec::new();
@@ -62,38 +79,61 @@ impl DepthControl {
             .iter()
             .map(|m| bounce_factor(m, &mut min_fresnel_of))
             .fold(0.0f32, f32::max);
-        DepthControl::new(radiance, reflectance)
+        let draws = scene.lights.iter().any(|l| matches!(l, Light::Quad(_)))
+            || scene.materials.iter().any(|m| m.glossy.is_some());
+        DepthControl {
+            tails_only: draws,
+            ..DepthControl::new(radiance, reflectance, gamma)
+        }
     }
 
-    pub fn new(radiance: f32, reflectance: f32) -> DepthControl {
+    pub fn new(radiance: f32, reflectance: f32, gamma: f32) -> DepthControl {
         let bound = if reflectance < 1.0 {
             radiance / (1.0 - reflectance)
         } else {
             f32::INFINITY
         };
+        let budget = if gamma >= 1.0 {
+            INVISIBLE.powf(gamma)
+        } else if gamma > 0.0 {
+            INVISIBLE * gamma
+        } else {
+            0.0
+        };
         DepthControl {
             radiance,
             reflectance,
+            budget,
+            tails_only: false,
             bound: if bound.is_nan() { f32::INFINITY } else { bound },
         }
     }
 
-    /// Whether a branch of weight `w` can add nothing visible.
-    #[inline(always)]
-    pub fn negligible(&self, w: Color) -> bool {
-        w.abs().max_element() * self.bound < INVISIBLE
+    /// No branch is ever left out (for tests, and scenes built without the control).
+    pub fn off() -> DepthControl {
+        DepthControl::new(f32::INFINITY, 1.0, 1.0)
     }
 
-    /// The depth after which every branch is negligible (the weight after `d` bounces is
-    /// at most `ρ^d`), if there is one.
+    /// What leaving out a branch of weight `w` can change in a channel, at most (infinite
+    /// for a weight that is not a number).
+    #[inline(always)]
+    pub fn cost(&self, w: Color) -> f32 {
+        if !w.is_finite() {
+            return f32::INFINITY;
+        }
+        w.abs().max_element() * self.bound
+    }
+
+    /// The depth after which a single chain of branches is left out (the weight after
+    /// `d` bounces is at most `ρ^d`), if there is one.
     pub fn depth_limit(&self) -> Option<u32> {
         if !self.bound.is_finite() {
             return None;
         }
-        if self.bound < INVISIBLE || self.reflectance == 0.0 {
+        if self.bound <= self.budget || self.reflectance == 0.0 {
             return Some(0);
         }
-        let d = ((INVISIBLE / self.bound).ln() / self.reflectance.ln()).ceil();
+        let d = ((self.budget / self.bound).ln() / self.reflectance.ln()).ceil();
         Some(d.clamp(0.0, u32::MAX as f32) as u32)
     }
 }
@@ -112,15 +152,25 @@ fn bounce_factor(m: &Material, min_fresnel: &mut impl FnMut(f32) -> f32) -> f32 
 }
 
 /// The smallest reflectance of a dielectric interface of index `ior` over every angle,
-/// from either side (at normal incidence for common glass; lower, near Brewster's angle,
-/// for very high indices), a little less to cover rounding.
+/// from either side, a little less to cover rounding. It is at normal incidence for
+/// common glass; for very high (or low) indices it is lower, near Brewster's angle
+/// `atan(n)` or `atan(1/n)`, which then comes close to grazing or to normal incidence:
+/// angles are searched on a coarse grid, and on geometric grids around both Brewster
+/// angles and their complements (as fine near 0 and π/2 as those angles are).
 fn min_fresnel(ior: f32) -> f32 {
-    let steps = 1024;
-    let f = (0..=steps)
-        .map(|k| (k as f32 / steps as f32 * std::f32::consts::FRAC_PI_2).cos())
-        .flat_map(|c| [fresnel_dielectric(c, 1.0, ior), fresnel_dielectric(c, ior, 1.0)])
-        .fold(1.0f32, f32::min);
-    0.99 * f
+    let half_pi = std::f32::consts::FRAC_PI_2;
+    let f = |theta: f32| {
+        let c = theta.clamp(0.0, half_pi).cos();
+        fresnel_dielectric(c, 1.0, ior).min(fresnel_dielectric(c, ior, 1.0))
+    };
+    let coarse = (0..=1024).map(|k| k as f32 / 1024.0 * half_pi);
+    let near_brewster = [ior.atan(), (1.0 / ior).atan()]
+        .into_iter()
+        .flat_map(|b| [b, half_pi - b])
+        .flat_map(|base| (0..=512).map(move |k| base * 0.5 * 4f32.powf(k as f32 / 512.0)))
+        .flat_map(|t| [t, half_pi - t]);
+    let least = coarse.chain(near_brewster).map(f).fold(1.0f32, f32::min);
+    0.99 * least
 }
 
 /// `R`: the largest local radiance of the scene (see the module's documentation).
@@ -197,17 +247,28 @@ mod tests {
 
     #[test]
     fn a_mirror_chain_stops_where_its_weight_cannot_show() {
-        // Mirrors of 0.9 under radiance 1: the tail after d bounces is 0.9^d · 10, which
-        // falls below 2⁻¹² after 101 bounces.
-        let c = DepthControl::new(1.0, 0.9);
+        // Mirrors of 0.9 under radiance 1: the tail after d bounces costs 0.9^d · 10,
+        // which falls below 2⁻¹² after 101 bounces.
+        let c = DepthControl::new(1.0, 0.9, 1.0);
+        assert_eq!(c.budget, INVISIBLE);
         assert_eq!(c.depth_limit(), Some(101));
-        assert!(!c.negligible(Color::splat(0.9f32.powi(100))));
-        assert!(c.negligible(Color::splat(0.9f32.powi(101))));
+        assert!(c.cost(Color::splat(0.9f32.powi(100))) > c.budget);
+        assert!(c.cost(Color::splat(0.9f32.powi(101))) <= c.budget);
+        // With gamma 2.2 the budget is what the encoding cannot show near black.
+        let g = DepthControl::new(1.0, 0.9, 2.2);
+        assert!((g.budget - INVISIBLE.powf(2.2)).abs() < 1e-12 && g.depth_limit() > Some(190));
+        assert_eq!(DepthControl::new(1.0, 0.9, 0.5).budget, INVISIBLE * 0.5);
         // A perfect mirror never dies out; nothing bright is always negligible.
-        assert_eq!(DepthControl::new(1.0, 1.0).depth_limit(), None);
-        assert!(!DepthControl::new(1.0, 1.0).negligible(Color::splat(1e-30)));
-        assert_eq!(DepthControl::new(0.0, 0.5).depth_limit(), Some(0));
-        assert_eq!(DepthControl::new(f32::NAN, 0.5).depth_limit(), None);
+        assert_eq!(DepthControl::new(1.0, 1.0, 1.0).depth_limit(), None);
+        assert_eq!(
+            DepthControl::new(1.0, 1.0, 1.0).cost(Color::splat(1e-30)),
+            f32::INFINITY
+        );
+        assert_eq!(DepthControl::new(0.0, 0.5, 1.0).depth_limit(), Some(0));
+        assert_eq!(DepthControl::new(f32::NAN, 0.5, 1.0).depth_limit(), None);
+        assert_eq!(DepthControl::off().depth_limit(), None);
+        // A weight that is not a number is never left out.
+        assert_eq!(c.cost(Color::new(f32::NAN, 0.0, 0.0)), f32::INFINITY);
     }
 
     #[test]
@@ -222,7 +283,15 @@ mod tests {
         let f = bounce_factor(&glass(1.5), &mut min_fresnel);
         assert!((0.96..0.961).contains(&f), "{f}");
         assert_eq!(bounce_factor(&glass(1.0), &mut min_fresnel), 1.0);
-        // Near Brewster's angle a very dense medium reflects less than head on.
+        // Near Brewster's angle a very dense medium reflects less than head on; the
+        // search finds it even for an index of 10⁴, where the angle is near grazing.
         assert!(min_fresnel(10.0) < 0.99 * fresnel_dielectric(1.0, 1.0, 10.0));
+        for ior in [10.0f32, 1e3, 1e4, 1e-3] {
+            let exact = (0..200_000)
+                .map(|k| (k as f32 / 200_000.0 * std::f32::consts::FRAC_PI_2).cos())
+                .map(|c| fresnel_dielectric(c, 1.0, ior).min(fresnel_dielectric(c, ior, 1.0)))
+                .fold(1.0f32, f32::min);
+            assert!(min_fresnel(ior) <= exact, "ior {ior}: {} > {exact}", min_fresnel(ior));
+        }
     }
 }

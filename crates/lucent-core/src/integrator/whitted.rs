@@ -50,6 +50,8 @@ struct Tracing<'a> {
     scene: &'a Scene,
     sampler: &'a mut Sampler,
     counts: &'a mut TraceCounts,
+    /// What left-out branches could have added (adaptive depth control's spending).
+    dropped: f32,
 }
 
 /// Branches of one ray tree waiting to be traced, at most this many at once (4 MB a
@@ -172,7 +174,7 @@ impl Whitted {
         let scene = t.scene;
         let (mut ray, mut depth, mut weight) = (ray, depth, weight);
         loop {
-            if self.depth.negligible(weight) {
+            if self.leave_out(t, weight, pending) {
                 return;
             }
             let Some((local, sp)) = self.shade(t, &ray) else {
@@ -258,6 +260,22 @@ impl Whitted {
         }
     }
 
+    /// Whether a branch of weight `w` is left out (adaptive depth control): what it could
+    /// add must fit in what is left of the sample's budget, and where the scene draws
+    /// random numbers after the camera ray, nothing may wait to be traced after it.
+    fn leave_out(&self, t: &mut Tracing, w: Color, pending: &[Branch]) -> bool {
+        if self.depth.tails_only && !pending.is_empty() {
+            return false;
+        }
+        let cost = self.depth.cost(w);
+        if t.dropped + cost <= self.depth.budget {
+            t.dropped += cost;
+            true
+        } else {
+            false
+        }
+    }
+
     /// Draws the next of a hit's glossy rays (`left` > 0 of them) and puts it on the
     /// stack, above the rays still to draw, so that it is traced before they are drawn.
     fn next_glossy(&self, t: &mut Tracing, glossy: Branch, pending: &mut Vec<Branch>) {
@@ -310,7 +328,12 @@ fn push(pending: &mut Vec<Branch>, b: Branch, counts: &mut TraceCounts) {
 impl Integrator for Whitted {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
         let mut total = BACKGROUND;
-        let mut t = Tracing { scene, sampler, counts };
+        let mut t = Tracing {
+            scene,
+            sampler,
+            counts,
+            dropped: 0.0,
+        };
         // Only a tree that branches allocates.
         let mut pending = Vec::new();
         self.follow(&mut t, *ray, 0, Color::ONE, &mut total, &mut pending);

@@ -137,7 +137,7 @@ fn render_tile(
             }
             let mut sum = Color::ZERO;
             for i in job.samples.clone() {
-                if i % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
+                if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
                 }
                 let mut sampler = Sampler::new(job.seed, x, y, i);

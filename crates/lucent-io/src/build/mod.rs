@@ -112,7 +112,7 @@ fn build_parts(
         environment,
     };
     let scene = Scene::new(parts, options.accel);
-    settings::control_depth(&mut integrator, &scene);
+    settings::control_depth(&mut integrator, &scene, desc.gamma() as f32);
     let work = settings::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
     Some(Built {
         scene,

@@ -50,13 +50,13 @@ pub fn integrator(desc: &SceneDesc, diags: &mut Diagnostics) -> Whitted {
         max_depth,
         light_samples,
         light_stratify,
-        depth: DepthControl::new(f32::INFINITY, 1.0),
+        depth: DepthControl::off(),
     }
 }
 
-/// Sets the integrator's adaptive depth control from the built scene.
-pub fn control_depth(whitted: &mut Whitted, scene: &Scene) {
-    whitted.depth = DepthControl::for_scene(scene);
+/// Sets the integrator's adaptive depth control from the built scene and its `gamma`.
+pub fn control_depth(whitted: &mut Whitted, scene: &Scene, gamma: f32) {
+    whitted.depth = DepthControl::for_scene(scene, gamma);
 }
 
 /// A render's work: the rays it traces, about.

@@ -87,6 +87,23 @@ pub fn surface_mesh(
     (!mesh.indices.is_empty()).then_some(mesh)
 }
 
+/// Takes the memory reading a mesh file costs (about eight bytes for each byte of it)
+/// from the budget, or reports at the file's name that it cannot; returns what was taken.
+fn take_reading(
+    res: &mut Resources,
+    path: &std::path::Path,
+    at: crate::diag::Loc,
+    command: &str,
+    diags: &mut Diagnostics,
+) -> Option<u64> {
+    let reading = std::fs::metadata(path).map_or(0, |m| m.len()).saturating_mul(8);
+    res.budget
+        .take(reading, &format!("{command}: reading {}", path.display()))
+        .map_err(|e| diags.error(at, e))
+        .ok()?;
+    Some(reading)
+}
+
 /// Takes the memory of `n` triangles (with their structure) from the budget, or reports
 /// at the shape's command that it cannot.
 fn take_triangles(
@@ -117,15 +134,12 @@ fn object_mesh(
             let path = &file.value;
             // Reading takes about eight bytes for each byte of the file; the mesh, once
             // read, its triangles' share.
-            let reading = std::fs::metadata(path).map_or(0, |m| m.len()).saturating_mul(8);
-            res.budget
-                .take(reading, &format!("mesh: reading {}", path.display()))
-                .map_err(|e| diags.error(file.loc, e))
-                .ok()?;
-            let loaded = load_mesh(path, res)
+            let reading = take_reading(res, path, file.loc, "mesh", diags)?;
+            let loaded = load_mesh(path, res);
+            res.budget.give_back(reading);
+            let loaded = loaded
                 .map_err(|e| diags.error(file.loc, format!("mesh: {}: {e}", path.display())))
                 .ok()?;
-            res.budget.give_back(reading);
             take_triangles(res, loaded.mesh.indices.len() as u64, shape, "mesh", diags)?;
             for w in &loaded.warnings {
                 diags.warning(file.loc, format!("mesh: {}: {w}", path.display()));
@@ -148,7 +162,10 @@ fn object_mesh(
         }
         SurfaceRecipe::Subdivision { scheme, levels, file } => {
             let path = &file.value;
-            let control = load_polygons(path, res)
+            let reading = take_reading(res, path, file.loc, "subdivmesh", diags)?;
+            let control = load_polygons(path, res);
+            res.budget.give_back(reading);
+            let control = control
                 .map_err(|e| diags.error(file.loc, format!("subdivmesh: {}: {e}", path.display())))
                 .ok()?;
             // Loop refines the fan triangulation, four triangles for one per level;
@@ -231,9 +248,13 @@ fn displaced(
         scale: d.scale as f32,
     };
     take_triangles(res, refined_triangles(mesh, &field) as u64, shape, command, diags)?;
-    displace(mesh, &field)
+    let displaced = displace(mesh, &field)
         .map_err(|e| diags.error(shape.loc, format!("{command}: displacementmap: {e}")))
-        .ok()
+        .ok()?;
+    // The surface before displacement is dropped.
+    res.budget
+        .give_back((mesh.indices.len() as u64).saturating_mul(BYTES_PER_TRIANGLE));
+    Some(displaced)
 }
 
 /// A mesh moved to world space by `t`, with `material` where its triangles have none of

@@ -14,7 +14,8 @@ pub(super) struct Command<'a> {
     pub name: Token<'a>,
     pub args: Vec<Token<'a>>,
     pub line: u32,
-    /// Column just past the last token (where a missing argument would go).
+    /// Column just past the end of the line, comment included (where a missing argument
+    /// is reported).
     pub end_col: u32,
 }
 

@@ -50,11 +50,14 @@ pub struct ParseOptions {
 /// Reads and parses a scene file (a regular file of at most [`MAX_SCENE_BYTES`]),
 /// recorded in `res`. A file that cannot be read is an error at `path:1:1`.
 pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (SceneDesc, Diagnostics) {
-    let read = read_input(path, MAX_SCENE_BYTES, &mut res.inputs).and_then(|bytes| {
-        // The description takes about eight bytes for each byte of text.
-        let what = format!("the scene file of {}", bytes_text(bytes.len() as u64));
-        res.budget.take(bytes.len() as u64 * 8, &what).map(|_| bytes)
-    });
+    // The text, and then its description at about eight bytes for each byte of text,
+    // are taken from the budget before the file is read.
+    let size = std::fs::metadata(path).map_or(0, |m| m.len());
+    let what = format!("the scene file of {}", bytes_text(size));
+    let read = res
+        .budget
+        .take(size.saturating_mul(9), &what)
+        .and_then(|_| read_input(path, MAX_SCENE_BYTES, &mut res.inputs));
     match read {
         Ok(bytes) => parse_bytes(&path.display().to_string(), &bytes, options),
         Err(e) => {

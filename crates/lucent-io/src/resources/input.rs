@@ -72,20 +72,26 @@ impl Inputs {
 
 /// Opens `path` for reading if it is a regular file of at most `limit` bytes; records it
 /// in `inputs`. Returns the file and its size.
+///
+/// The path is looked at first, so that nothing but a regular file is ever opened (opening
+/// a device can have effects of its own); it is then opened without blocking (a FIFO
+/// swapped in meanwhile cannot hang the open) and must still be the same file.
 pub fn open_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<(File, u64), String> {
+    let before = std::fs::metadata(path).map_err(|e| io_reason(&e))?;
+    if !before.is_file() {
+        return Err(format!("not a regular file ({})", kind(&before)));
+    }
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
     {
         use std::os::unix::fs::OpenOptionsExt;
-        // Opening a FIFO would otherwise wait for a writer; on a regular file the flag
-        // changes nothing.
-        options.custom_flags(libc::O_NONBLOCK);
+        options.custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY);
     }
     let file = options.open(path).map_err(|e| io_reason(&e))?;
     let meta = file.metadata().map_err(|e| io_reason(&e))?;
-    if !meta.is_file() {
-        return Err(format!("not a regular file ({})", kind(&meta)));
+    if !meta.is_file() || FileId::of(&meta) != FileId::of(&before) {
+        return Err("the file changed while it was opened".into());
     }
     if meta.len() > limit {
         return Err(format!(
@@ -98,15 +104,18 @@ pub fn open_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<(File,
     Ok((file, meta.len()))
 }
 
-/// The whole of a regular file of at most `limit` bytes (see [`open_input`]).
+/// The whole of a regular file of at most `limit` bytes (see [`open_input`]); a file
+/// that grows while it is read is an error.
 pub fn read_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<Vec<u8>, String> {
     let (file, size) = open_input(path, limit, inputs)?;
     let mut bytes = Vec::new();
     bytes
         .try_reserve_exact(size as usize)
         .map_err(|_| format!("no memory for the file's {}", self::bytes(size)))?;
-    // A file that grows while it is read stops at its limit.
-    file.take(limit).read_to_end(&mut bytes).map_err(|e| io_reason(&e))?;
+    file.take(size + 1).read_to_end(&mut bytes).map_err(|e| io_reason(&e))?;
+    if bytes.len() as u64 > size {
+        return Err("the file grew while it was read".into());
+    }
     Ok(bytes)
 }
 

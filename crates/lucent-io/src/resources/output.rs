@@ -73,9 +73,10 @@ impl OutputTarget {
         Err("too many levels of symbolic links".into())
     }
 
-    /// An error if writing would overwrite one of the run's inputs.
+    /// An error if writing would overwrite one of the run's inputs (through a link into
+    /// `/proc` too).
     pub fn check_not_input(&self, inputs: &Inputs) -> Result<(), String> {
-        let OutputTarget::File(path) = self else {
+        let (OutputTarget::File(path) | OutputTarget::Device(path)) = self else {
             return Ok(());
         };
         match fs::metadata(path) {
@@ -146,6 +147,11 @@ fn write_device(path: &Path, bytes: &[u8]) -> Result<(), String> {
             }
         }
     }
+    // A link into /proc may lead to a regular file (standard output sent to one): it is
+    // written from its start, and only what is written remains, as `>` would.
+    if file.metadata().is_ok_and(|m| m.is_file()) {
+        file.set_len(0).map_err(|e| io_reason(&e))?;
+    }
     file.write_all(bytes)
         .and_then(|_| file.flush())
         .map_err(|e| io_reason(&e))
@@ -165,20 +171,34 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
 /// removing them needs no allocation (the allocation-failure path uses it).
 static TEMPORARY: Mutex<Vec<CString>> = Mutex::new(Vec::new());
 
-/// Removes every temporary file this process has not renamed yet: for the signal
-/// handler and for the last words of a failed allocation. Never allocates; gives up if
-/// another thread holds the list.
+/// Removes every temporary file this process has not renamed yet, for the last words of
+/// a failed allocation: never allocates, and gives up if another thread holds the list
+/// (it may be this one).
 pub fn remove_temporary_files() {
     if let Ok(list) = TEMPORARY.try_lock() {
-        for c in list.iter() {
-            #[cfg(unix)]
-            // SAFETY: a valid NUL-terminated path; unlink is async-signal-safe.
-            unsafe {
-                libc::unlink(c.as_ptr());
-            }
-            #[cfg(not(unix))]
-            let _ = c;
+        unlink_all(&list);
+    }
+}
+
+/// Removes every temporary file and ends the process with `code`, holding the list so
+/// that no temporary file can be made meanwhile (for the signal handler).
+pub fn remove_temporary_files_and_exit(code: i32) -> ! {
+    let list = TEMPORARY.lock().unwrap_or_else(|e| e.into_inner());
+    unlink_all(&list);
+    // SAFETY: ends the process at once, without running exit handlers that the main
+    // thread may be running too.
+    unsafe { libc::_exit(code) }
+}
+
+fn unlink_all(list: &[CString]) {
+    for c in list {
+        #[cfg(unix)]
+        // SAFETY: a valid NUL-terminated path.
+        unsafe {
+            libc::unlink(c.as_ptr());
         }
+        #[cfg(not(unix))]
+        let _ = c;
     }
 }
 
@@ -192,52 +212,61 @@ struct TemporaryFile {
     path: PathBuf,
     file: Option<File>,
     registered: Option<CString>,
+    /// Renamed over its target: nothing to remove.
+    renamed: bool,
 }
 
 impl TemporaryFile {
-    /// `.NAME.PID.lucent-tmp` beside `target`, or `.lucent-PID.tmp` when that name would
-    /// be longer than a file name may be.
+    /// `.NAME.PID.lucent-tmp` beside `target` (`.NAME.PID.N.lucent-tmp` if that exists
+    /// already: another process's file is never touched), or `.lucent-PID.N.tmp` when
+    /// that name would be longer than a file name may be. Made and registered under the
+    /// list's lock, so that the signal handler sees every one.
     fn create(target: &Path) -> Result<TemporaryFile, String> {
         let name = target
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         let pid = std::process::id();
-        let long = format!(".{name}.{pid}.lucent-tmp");
-        let short = format!(".lucent-{pid}.tmp");
-        let tmp_name = if long.len() <= NAME_MAX { long } else { short };
-        let path = target.with_file_name(tmp_name);
-        let registered = path_cstring(&path);
-        if let Some(c) = &registered {
-            TEMPORARY.lock().unwrap_or_else(|e| e.into_inner()).push(c.clone());
-        }
-        let mut tmp = TemporaryFile {
-            path,
-            file: None,
-            registered,
-        };
-        tmp.file = Some(
-            fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&tmp.path)
-                .or_else(|e| {
-                    // A stale one of this process (same pid, an earlier run) goes first.
-                    if e.kind() == std::io::ErrorKind::AlreadyExists {
-                        let _ = fs::remove_file(&tmp.path);
-                        fs::OpenOptions::new().write(true).create_new(true).open(&tmp.path)
-                    } else {
-                        Err(e)
+        let mut list = TEMPORARY.lock().unwrap_or_else(|e| e.into_inner());
+        // Room first: an allocation failing after the file exists could not remove it.
+        list.reserve(1);
+        for attempt in 0..100u32 {
+            let n = if attempt == 0 {
+                String::new()
+            } else {
+                format!(".{attempt}")
+            };
+            let long = format!(".{name}.{pid}{n}.lucent-tmp");
+            let tmp_name = if long.len() <= NAME_MAX {
+                long
+            } else {
+                format!(".lucent-{pid}{n}.tmp")
+            };
+            let path = target.with_file_name(tmp_name);
+            let registered = path_cstring(&path);
+            match fs::OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(file) => {
+                    if let Some(c) = &registered {
+                        list.push(c.clone());
                     }
-                })
-                .map_err(|e| io_reason(&e))?,
-        );
-        Ok(tmp)
+                    return Ok(TemporaryFile {
+                        path,
+                        file: Some(file),
+                        registered,
+                        renamed: false,
+                    });
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+                Err(e) => return Err(io_reason(&e)),
+            }
+        }
+        Err("cannot find a free name for a temporary file beside it".into())
     }
 
     fn rename_over(mut self, target: &Path) -> Result<(), String> {
         self.file = None;
         fs::rename(&self.path, target).map_err(|e| io_reason(&e))?;
+        self.renamed = true;
         self.unregister();
         Ok(())
     }
@@ -254,7 +283,7 @@ impl TemporaryFile {
 
 impl Drop for TemporaryFile {
     fn drop(&mut self) {
-        if self.registered.is_some() {
+        if !self.renamed {
             self.file = None;
             let _ = fs::remove_file(&self.path);
             self.unregister();
