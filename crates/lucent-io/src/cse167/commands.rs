@@ -155,28 +155,51 @@ fn suggestion(name: &str) -> Option<&'static str> {
     if name.len() > 32 {
         return None;
     }
-    let lower = name.to_lowercase();
-    if let Some(c) = command_names().find(|c| c.to_lowercase() == lower) {
-        return Some(c);
+    let lower: Vec<char> = name.to_lowercase().chars().collect();
+    let mut best: Option<(usize, &'static str)> = None;
+    for (known, command) in lowered() {
+        // Names whose lengths differ by more than two are more than two edits apart.
+        if known.len().abs_diff(lower.len()) > 2 {
+            continue;
+        }
+        let d = edit_distance(&lower, known);
+        if d == 0 {
+            return Some(command);
+        }
+        if d <= 2 && best.is_none_or(|(b, _)| d < b) {
+            best = Some((d, command));
+        }
     }
-    command_names()
-        .map(|c| (edit_distance(&lower, &c.to_lowercase()), c))
-        .filter(|(d, _)| *d <= 2)
-        .min_by_key(|(d, _)| *d)
-        .map(|(_, c)| c)
+    best.map(|(_, c)| c)
 }
 
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut cur = vec![i + 1; b.len() + 1];
-        for (j, &cb) in b.iter().enumerate() {
+/// Every command's name in lower case (for [`suggestion`]).
+fn lowered() -> &'static [(Vec<char>, &'static str)] {
+    static LOWERED: OnceLock<Vec<(Vec<char>, &'static str)>> = OnceLock::new();
+    LOWERED.get_or_init(|| {
+        command_names()
+            .map(|c| (c.to_lowercase().chars().collect(), c))
+            .collect()
+    })
+}
+
+/// Levenshtein distance of two names of at most 34 characters (rows on the stack).
+fn edit_distance(a: &[char], b: &[char]) -> usize {
+    const ROW: usize = 35;
+    let n = b.len().min(ROW - 1);
+    let mut prev = [0usize; ROW];
+    let mut cur = [0usize; ROW];
+    for (j, p) in prev.iter_mut().enumerate().take(n + 1) {
+        *p = j;
+    }
+    for (i, &ca) in a.iter().enumerate() {
+        cur[0] = i + 1;
+        for (j, &cb) in b.iter().take(n).enumerate() {
             cur[j + 1] = (prev[j] + (ca != cb) as usize).min(prev[j + 1] + 1).min(cur[j] + 1);
         }
-        prev = cur;
+        std::mem::swap(&mut prev, &mut cur);
     }
-    prev[b.len()]
+    prev[n]
 }
 
 #[cfg(test)]
