@@ -249,10 +249,8 @@ pub fn load_obj_polygons(path: &Path, res: &mut Resources) -> Result<ControlMesh
 mod tests {
     use super::*;
 
-    fn temp_dir(name: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("lucent-obj-{name}-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn temp_dir(name: &str) -> crate::TestDir {
+        crate::TestDir::new(&format!("obj-{name}"))
     }
 
     #[test]
@@ -272,7 +270,6 @@ mod tests {
         assert_eq!(z(2), [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)]);
         assert!(m.normals.is_empty() && m.uvs.is_empty() && m.materials.is_empty());
         assert!(load_obj(&dir.join("missing.obj"), &mut Resources::new(u64::MAX)).is_err());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
@@ -307,7 +304,6 @@ mod tests {
         let loaded = load_obj(&dir.join("two.obj"), &mut Resources::new(u64::MAX)).unwrap();
         assert_eq!(loaded.warnings.len(), 1, "{:?}", loaded.warnings);
         assert!(loaded.mesh.materials.is_empty());
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
@@ -324,6 +320,5 @@ mod tests {
                 "{name}"
             );
         }
-        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -213,9 +213,7 @@ mod tests {
                           property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n\
                           element face 1\nproperty list uchar int vertex_indices\nend_header\n";
 
-    fn write(name: &str, bytes: &[u8]) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("lucent-ply-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+    fn write(dir: &crate::TestDir, name: &str, bytes: &[u8]) -> std::path::PathBuf {
         let path = dir.join(name);
         std::fs::write(&path, bytes).unwrap();
         path
@@ -224,9 +222,12 @@ mod tests {
     #[test]
     fn ascii_quads_are_fanned_with_normals_and_uvs() {
         let text = format!("{HEADER}0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n");
-        let m = load_ply(&write("quad.ply", text.as_bytes()), &mut Resources::new(u64::MAX))
-            .unwrap()
-            .mesh;
+        let m = load_ply(
+            &write(&crate::TestDir::new("ply-quad"), "quad.ply", text.as_bytes()),
+            &mut Resources::new(u64::MAX),
+        )
+        .unwrap()
+        .mesh;
         assert_eq!(m.indices, vec![[0, 1, 2], [0, 2, 3]]);
         assert_eq!(m.normals, vec![Vec3::Z; 4]);
         assert_eq!(m.uvs[2], Vec2::new(1.0, 1.0));
@@ -250,9 +251,12 @@ mod tests {
         }
         bytes.extend(0i32.to_le_bytes());
         bytes.extend(1i32.to_le_bytes());
-        let m = load_ply(&write("bin.ply", &bytes), &mut Resources::new(u64::MAX))
-            .unwrap()
-            .mesh;
+        let m = load_ply(
+            &write(&crate::TestDir::new("ply-bin"), "bin.ply", &bytes),
+            &mut Resources::new(u64::MAX),
+        )
+        .unwrap()
+        .mesh;
         assert_eq!(m.indices, vec![[0, 1, 2]]);
         assert_eq!(m.positions[2], Vec3::new(0.0, 2.0, 0.0));
         assert!(m.normals.is_empty() && m.uvs.is_empty());
@@ -260,6 +264,7 @@ mod tests {
 
     #[test]
     fn malformed_files_are_errors() {
+        let dir = crate::TestDir::new("ply-bad");
         let cases: [(&str, String); 5] = [
             (
                 "header.ply",
@@ -277,7 +282,7 @@ mod tests {
             ("text.ply", "not a ply file\n".into()),
         ];
         for (name, text) in cases {
-            let e = load_ply(&write(name, text.as_bytes()), &mut Resources::new(u64::MAX));
+            let e = load_ply(&write(&dir, name, text.as_bytes()), &mut Resources::new(u64::MAX));
             assert!(e.is_err(), "{name}");
         }
         assert!(load_ply(Path::new("/nonexistent/x.ply"), &mut Resources::new(u64::MAX)).is_err());

@@ -417,8 +417,8 @@ fn analytic_shapes() {
 
 #[test]
 fn bezier_patch_files() {
-    let dir = std::env::temp_dir().join(format!("lucent-patches-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let temp = common::TempDir::new("patches");
+    let dir = &temp.0;
     std::fs::write(
         dir.join("bad.bpt"),
         "1\n1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16\n2\n0 0 0\n1 1\n",

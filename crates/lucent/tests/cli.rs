@@ -1,7 +1,7 @@
 //! The `lucent` binary end to end: exit codes, messages, and what is (not) written.
 
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 const SCENE: &str = "size 32 24\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 1 1 3 1 1 1\ndiffuse 0.6 0.3 0.2\nspecular 0.3 0.3 0.3\nsphere 0 0 0 1\nvertex -3 -1 -3\nvertex 3 -1 -3\nvertex 3 -1 3\ntri 0 2 1\n";
@@ -11,7 +11,7 @@ mod common;
 use common::files_in;
 
 /// A fresh, empty directory for one test.
-fn workdir(name: &str) -> PathBuf {
+fn workdir(name: &str) -> common::WorkDir {
     common::workdir("cli", name)
 }
 

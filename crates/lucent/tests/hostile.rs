@@ -26,7 +26,7 @@ fn data(name: &str) -> PathBuf {
 mod common;
 
 /// A fresh, empty directory for one test.
-fn workdir(name: &str) -> PathBuf {
+fn workdir(name: &str) -> common::WorkDir {
     common::workdir("hostile", name)
 }
 
