@@ -114,10 +114,13 @@ impl DepthControl {
         DepthControl::new(f32::INFINITY, 1.0, 1.0)
     }
 
-    /// What leaving out a branch of weight `w` can change in a channel, at most. (A
-    /// channel that is not a number is not counted: callers keep such a branch.)
+    /// What leaving out a branch of weight `w` can change in a channel, at most (infinite
+    /// for a weight that is not a number).
     #[inline(always)]
     pub fn cost(&self, w: Color) -> f32 {
+        if !w.is_finite() {
+            return f32::INFINITY;
+        }
         w.abs().max_element() * self.bound
     }
 
@@ -269,6 +272,8 @@ mod tests {
         assert_eq!(DepthControl::new(0.0, 0.5, 1.0).depth_limit(), Some(0));
         assert_eq!(DepthControl::new(f32::NAN, 0.5, 1.0).depth_limit(), None);
         assert_eq!(DepthControl::off().depth_limit(), None);
+        // A weight that is not a number is never left out.
+        assert_eq!(c.cost(Color::new(f32::NAN, 0.0, 0.0)), f32::INFINITY);
     }
 
     #[test]

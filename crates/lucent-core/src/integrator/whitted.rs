@@ -213,44 +213,50 @@ impl Whitted {
             // bounce up to `maxdepth`, and adaptive depth control stops them where they
             // cannot show.)
             let negligible = m.transparent != Color::ZERO && (weight * mirror).max_element() <= MIN_WEIGHT;
-            if mirror == Color::ZERO || negligible {
-                if let Some(b) = refracted {
-                    push(pending, b, t.counts);
-                }
-                return;
-            }
-            let r = reflect(d, n).normalize();
-            // The mirror chain goes on in this loop (the common case: no branching).
-            if refracted.is_none() && m.glossy.is_none() {
-                (ray, depth, weight) = (Ray::new(sp.point, r), depth + 1, weight * mirror);
-                continue;
-            }
-            let reflected = match m.glossy {
-                Some(g) => {
-                    let count = if depth == 0 { g.samples.max(1) } else { 1 };
-                    Branch::Glossy {
-                        point: sp.point,
-                        mirror: r,
-                        // Rays leave on the side the reflected ray is on.
-                        side: if r.dot(n) >= 0.0 { n } else { -n },
-                        exponent: g.exponent,
-                        left: count,
-                        depth: depth + 1,
-                        weight: weight * mirror / count as f32,
+            let reflected = if mirror == Color::ZERO || negligible {
+                None
+            } else {
+                let r = reflect(d, n).normalize();
+                Some(match m.glossy {
+                    Some(g) => {
+                        let count = if depth == 0 { g.samples.max(1) } else { 1 };
+                        Branch::Glossy {
+                            point: sp.point,
+                            mirror: r,
+                            // Rays leave on the side the reflected ray is on.
+                            side: if r.dot(n) >= 0.0 { n } else { -n },
+                            exponent: g.exponent,
+                            left: count,
+                            depth: depth + 1,
+                            weight: weight * mirror / count as f32,
+                        }
                     }
-                }
-                None => Branch::Ray {
-                    ray: Ray::new(sp.point, r),
-                    depth: depth + 1,
-                    weight: weight * mirror,
-                },
+                    None => Branch::Ray {
+                        ray: Ray::new(sp.point, r),
+                        depth: depth + 1,
+                        weight: weight * mirror,
+                    },
+                })
             };
-            // The refracted branch is traced first, then the reflected one.
-            push(pending, reflected, t.counts);
-            if let Some(b) = refracted {
-                push(pending, b, t.counts);
+            match (refracted, reflected) {
+                // The mirror chain goes on in this loop.
+                (
+                    None,
+                    Some(Branch::Ray {
+                        ray: r,
+                        depth: d,
+                        weight: w,
+                    }),
+                ) => (ray, depth, weight) = (r, d, w),
+                (None, None) => return,
+                // The refracted branch is traced first, then the reflected one.
+                (refracted, reflected) => {
+                    for b in [reflected, refracted].into_iter().flatten() {
+                        push(pending, b, t.counts);
+                    }
+                    return;
+                }
             }
-            return;
         }
     }
 
@@ -262,7 +268,7 @@ impl Whitted {
             return false;
         }
         let cost = self.depth.cost(w);
-        if t.dropped + cost <= self.depth.budget && w.is_finite() {
+        if t.dropped + cost <= self.depth.budget {
             t.dropped += cost;
             true
         } else {
