@@ -10,7 +10,7 @@
 //!
 //! | floor | modules |
 //! |---|---|
-//! | 0 base | [`math`], [`transform`], [`ray`], [`aabb`], [`hit`], [`sampler`] |
+//! | 0 base | [`math`], [`transform`], [`ray`], [`aabb`], [`hit`], [`sampler`], [`sampling`] |
 //! | 1 shapes | [`shape`]: intersection routines, texture coordinates, tangents |
 //! | 2 acceleration | [`accel`]: structures over any [`accel::PrimitiveSet`] |
 //! | 3 geometry | [`geometry`]: primitives, meshes, instances, the primitive set |
@@ -28,6 +28,7 @@ pub mod hit;
 pub mod math;
 pub mod ray;
 pub mod sampler;
+pub mod sampling;
 pub mod transform;
 
 pub mod shape;

@@ -20,6 +20,7 @@ const CORE: Floors = &[
     ("aabb", 0),
     ("hit", 0),
     ("sampler", 0),
+    ("sampling", 0),
     ("shape", 1),
     ("accel", 2),
     ("geometry", 3),
