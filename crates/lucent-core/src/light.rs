@@ -2,6 +2,11 @@
 //! `attenuation c0 c1 c2` (SCENE_FORMAT.md §3.5) and `quadLight a ab ac Le` (§3.7): a
 //! one-sided parallelogram of radiance `Le`, sampled by `lightsamples` shadow rays
 //! (stratified with `lightstratify on`).
+//!
+//! Every light can be sampled from a receiving point ([`Light::sample_li`]: a direction,
+//! the radiance arriving along it and its solid-angle density, or a delta for point and
+//! directional lights); a quad light also gives the density of a direction that a BSDF
+//! sample found it along ([`QuadLight::pdf_li`]), for multiple importance sampling.
 
 use crate::math::{Color, Vec3A};
 
@@ -74,6 +79,72 @@ impl QuadLight {
     }
 }
 
+/// A light sample seen from a receiving point: the unit direction `wi` toward it, the
+/// distance to the sampled point (infinite for directional lights), the radiance that
+/// arrives along `wi` (a delta light's attenuated intensity) and the solid-angle density
+/// of `wi` (1 for delta lights, which only one direction reaches).
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    pub wi: Vec3A,
+    pub distance: f32,
+    pub radiance: Color,
+    pub pdf: f32,
+    pub is_delta: bool,
+}
+
+impl QuadLight {
+    /// A point drawn uniformly on the light by `(u, v)`, as seen from `x`: `None` when
+    /// `x` sees the light's back or edge (it receives nothing from there).
+    #[inline]
+    pub fn sample_li(&self, x: Vec3A, u: f32, v: f32) -> Option<LightSample> {
+        let to_light = self.point(u, v) - x;
+        let r2 = to_light.length_squared();
+        let distance = r2.sqrt();
+        let wi = to_light / distance;
+        let cos_light = self.normal.dot(wi);
+        // Density by area 1/A, in solid angle r² / (A cos θ_light).
+        let pdf = r2 / (self.area * cos_light);
+        (cos_light > 0.0 && pdf.is_finite()).then_some(LightSample {
+            wi,
+            distance,
+            radiance: self.radiance,
+            pdf,
+            is_delta: false,
+        })
+    }
+
+    /// The solid-angle density with which [`QuadLight::sample_li`] draws the direction
+    /// `wi` that meets the light at `distance` (0 from behind).
+    #[inline]
+    pub fn pdf_li(&self, distance: f32, wi: Vec3A) -> f32 {
+        let cos_light = self.normal.dot(wi);
+        if cos_light > 0.0 {
+            distance * distance / (self.area * cos_light)
+        } else {
+            0.0
+        }
+    }
+
+    /// Where the ray from `x` along `wi` meets the parallelogram (either side), if it does.
+    pub fn intersect(&self, x: Vec3A, wi: Vec3A) -> Option<f32> {
+        let n = self.ab.cross(self.ac);
+        let denom = n.dot(wi);
+        if denom == 0.0 {
+            return None;
+        }
+        let t = n.dot(self.corner - x) / denom;
+        if !(t > 0.0) {
+            return None;
+        }
+        let p = x + wi * t - self.corner;
+        // Coordinates of p in (ab, ac): p × ac · n / |n|² and ab × p · n / |n|².
+        let nn = n.length_squared();
+        let u = p.cross(self.ac).dot(n) / nn;
+        let v = self.ab.cross(p).dot(n) / nn;
+        ((0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v)).then_some(t)
+    }
+}
+
 /// What a light delivers to a point: the unit direction toward it, the distance to it
 /// (infinite for directional lights) and the attenuated colour.
 #[derive(Clone, Copy, Debug)]
@@ -84,6 +155,31 @@ pub struct Incidence {
 }
 
 impl Light {
+    /// Point and directional lights: light from a single direction, which no BSDF
+    /// sample can find.
+    pub fn is_delta(&self) -> bool {
+        !matches!(self, Light::Quad(_))
+    }
+
+    /// A sample of the light seen from `x` (see [`LightSample`]); `(u, v)` picks the
+    /// point of an area light. `None` when nothing arrives.
+    #[inline]
+    pub fn sample_li(&self, x: Vec3A, u: f32, v: f32) -> Option<LightSample> {
+        match self {
+            Light::Quad(q) => q.sample_li(x, u, v),
+            _ => {
+                let inc = self.incidence(x);
+                (inc.distance > 0.0 && inc.dir.is_finite()).then_some(LightSample {
+                    wi: inc.dir,
+                    distance: inc.distance,
+                    radiance: inc.intensity,
+                    pdf: 1.0,
+                    is_delta: true,
+                })
+            }
+        }
+    }
+
     /// The radiance a ray travelling along `dir` sees where it meets the light's surface
     /// with normal `normal`: a quad light's radiance on its emitting side, black from
     /// behind (and nothing for lights that have no surface).
@@ -125,6 +221,7 @@ impl Light {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::chi2::chi2_test_edged;
 
     #[test]
     fn point_lights_attenuate_and_directional_lights_do_not() {
@@ -163,5 +260,48 @@ mod tests {
         let above = q.incidence(Vec3A::new(0.0, 4.0, 0.0), q.point(0.5, 0.5));
         assert_eq!(above.intensity, Color::ZERO);
         assert!(QuadLight::new(Vec3A::ZERO, Vec3A::X, Vec3A::X * 2.0, Color::ONE).is_none());
+    }
+
+    #[test]
+    fn quad_light_samples_follow_their_solid_angle_density() {
+        // Lights seen head on, obliquely, large and near, sheared and to the side (the
+        // bins are fixed, so a light must cover a good many of them).
+        let x = Vec3A::new(0.1, -0.2, 0.05);
+        let lights = [
+            (Vec3A::new(-0.5, 1.0, -0.5), Vec3A::Z, Vec3A::X),
+            (
+                Vec3A::new(0.3, 0.4, -1.0),
+                Vec3A::new(0.0, 0.3, 1.0),
+                Vec3A::new(1.5, 0.2, 0.0),
+            ),
+            (Vec3A::new(-3.0, 0.5, -3.0), Vec3A::Z * 6.0, Vec3A::new(6.0, 1.0, 0.0)),
+            (
+                Vec3A::new(1.0, 1.5, 0.2),
+                Vec3A::new(0.0, 0.0, 1.0),
+                Vec3A::new(0.8, -0.2, 0.3),
+            ),
+        ];
+        for (k, (a, ab, ac)) in lights.into_iter().enumerate() {
+            let q = QuadLight::new(a, ab, ac, Color::ONE).unwrap();
+            // Seen from the emitting side (swap ab and ac when x is behind).
+            let q = if q.normal.dot(q.point(0.5, 0.5) - x) > 0.0 {
+                q
+            } else {
+                QuadLight::new(a, ac, ab, Color::ONE).unwrap()
+            };
+            chi2_test_edged(
+                &format!("quad light {k}"),
+                |u, v| q.sample_li(x, u, v).map(|s| s.wi),
+                |wi| q.intersect(x, wi).map_or(0.0, |t| q.pdf_li(t, wi)),
+            );
+            // The sample's own density is the one pdf_li gives its direction.
+            for (u, v) in [(0.1, 0.2), (0.7, 0.9), (0.5, 0.5)] {
+                let s = q.sample_li(x, u, v).unwrap();
+                let p = q.pdf_li(s.distance, s.wi);
+                assert!((s.pdf - p).abs() <= 1e-4 * p, "{} {}", s.pdf, p);
+                let t = q.intersect(x, s.wi).unwrap();
+                assert!((t - s.distance).abs() < 1e-4 * t);
+            }
+        }
     }
 }

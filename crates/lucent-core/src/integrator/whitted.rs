@@ -38,8 +38,8 @@ use crate::math::{Color, Vec3A};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
-use crate::shading::bump;
 use crate::shading::optics::{fresnel_dielectric, phong_lobe, reflect, refract};
+use crate::shading::surface;
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
 /// 8-bit step: they are not traced.
@@ -103,14 +103,9 @@ impl Whitted {
             return Some((scene.lights[light as usize].radiance_seen(ray.dir, sp.normal), sp));
         }
         let m = &scene.materials[sp.material as usize];
-        if let Some(bump) = m.bump_map {
-            let (dpdu, dpdv) = scene.tangents(&hit, ray);
-            sp.normal = bump::bumped_normal(&scene.textures[bump.texture as usize], bump, &sp, dpdu, dpdv);
-        }
-        let diffuse = match m.diffuse_map {
-            Some(t) => m.diffuse * scene.textures[t as usize].eval(sp.uv, sp.point),
-            None => m.diffuse,
-        };
+        let shaded = surface::shade(m, &scene.textures, &sp, || scene.tangents(&hit, ray));
+        sp.normal = shaded.normal;
+        let diffuse = shaded.diffuse;
         let n = sp.normal;
         let view = -ray.dir;
         let mut color = m.ambient + m.emission;

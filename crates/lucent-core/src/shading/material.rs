@@ -1,9 +1,11 @@
 //! Scene commands: `ambient`, `diffuse`, `specular`, `emission`, `shininess` — the
 //! material every object captures when it is created (SCENE_FORMAT.md §3.6) — and the
-//! extensions `transparent`, `ior` and `glossy`. In the Whitted ray tracer `specular` is
-//! also the mirror reflectance.
+//! extensions `transparent`, `ior` and `glossy`, and the CSE168 `brdf phong|ggx` and
+//! `roughness` that choose the BSDF of the Monte Carlo integrators ([`super::bsdf`]). In
+//! the Whitted ray tracer `specular` is also the mirror reflectance.
 
-use crate::math::Color;
+use super::bsdf::{Bsdf, Ggx, Phong};
+use crate::math::{Color, Vec3A};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {
@@ -22,6 +24,16 @@ pub struct Material {
     pub diffuse_map: Option<u32>,
     /// `bumpmap`: the texture whose luminance, times `strength`, is a height field.
     pub bump_map: Option<BumpMap>,
+    /// `brdf`: the model of the Monte Carlo integrators.
+    pub brdf: BrdfModel,
+    /// `roughness`: GGX's α.
+    pub roughness: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BrdfModel {
+    Phong,
+    Ggx,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,7 +49,8 @@ pub struct Glossy {
 }
 
 impl Default for Material {
-    /// The format's initial state: ambient 0.2, everything else 0, shininess 1.
+    /// The format's initial state: ambient 0.2, everything else 0, shininess 1, the
+    /// Phong BRDF, roughness 1.
     fn default() -> Self {
         Material {
             ambient: Color::splat(0.2),
@@ -50,6 +63,29 @@ impl Default for Material {
             glossy: None,
             diffuse_map: None,
             bump_map: None,
+            brdf: BrdfModel::Phong,
+            roughness: 1.0,
+        }
+    }
+}
+
+impl Material {
+    /// The BSDF at a point with unit shading normal `normal` and (textured) diffuse
+    /// colour `diffuse`.
+    pub fn bsdf(&self, normal: Vec3A, diffuse: Color) -> Bsdf {
+        match self.brdf {
+            BrdfModel::Phong => Bsdf::Phong(Phong {
+                n: normal,
+                kd: diffuse,
+                ks: self.specular,
+                shininess: self.shininess,
+            }),
+            BrdfModel::Ggx => Bsdf::Ggx(Ggx {
+                n: normal,
+                kd: diffuse,
+                ks: self.specular,
+                alpha: self.roughness,
+            }),
         }
     }
 }

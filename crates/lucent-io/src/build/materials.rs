@@ -5,11 +5,11 @@
 
 use std::path::Path;
 
-use lucent_core::shading::material::{BumpMap, Glossy, Material};
+use lucent_core::shading::material::{BrdfModel, BumpMap, Glossy, Material};
 use lucent_core::shading::texture::{EnvironmentMap, Texture};
 
 use super::to_f32;
-use crate::desc::{MaterialDesc, SceneDesc, TextureSource};
+use crate::desc::{Brdf, MaterialDesc, SceneDesc, TextureSource};
 use crate::diag::{Diagnostics, Loc};
 use crate::mesh_file::MeshMaterial;
 use crate::resources::Resources;
@@ -135,6 +135,11 @@ fn material(m: &MaterialDesc) -> Material {
             texture: b.texture,
             strength: b.strength as f32,
         }),
+        brdf: match m.brdf {
+            Brdf::Phong => BrdfModel::Phong,
+            Brdf::Ggx => BrdfModel::Ggx,
+        },
+        roughness: m.roughness as f32,
     }
 }
 
