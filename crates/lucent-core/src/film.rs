@@ -1,50 +1,56 @@
-//! The image being rendered: linear RGB floats, row 0 at the top, and its 8-bit encoding
-//! (SCENE_FORMAT.md §4.1): clamp to [0, 1], apply `gamma`, then **truncate**
-//! `floor(255 c)`.
+//! The film: per pixel, the sum of its samples' radiance (f64, in the order the samples
+//! were taken) and their count. Sums, not averages, so that a render can take more
+//! samples later and two renders of disjoint pixels or sample ranges can be merged;
+//! [`Film::resolve`] divides them into the [`Image`] that is written.
 
-use crate::math::Color;
+use crate::image::Image;
+use crate::math::{Color, DVec3};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
     /// Row-major, top row first.
-    pub pixels: Vec<Color>,
+    pub sums: Vec<DVec3>,
+    pub counts: Vec<u32>,
 }
 
 impl Film {
     pub fn new(width: u32, height: u32) -> Film {
+        let n = width as usize * height as usize;
         Film {
             width,
             height,
-            pixels: vec![Color::ZERO; width as usize * height as usize],
+            sums: vec![DVec3::ZERO; n],
+            counts: vec![0; n],
         }
     }
 
-    /// Interleaved linear RGB floats, top row first (for EXR and HDR files); samples
-    /// that were not finite are already 0.
-    pub fn to_rgb_f32(&self) -> Vec<f32> {
-        self.pixels.iter().flat_map(|p| p.to_array()).collect()
+    /// Adds a pixel's `count` samples, whose radiance sums to `sum`.
+    #[inline]
+    pub fn add(&mut self, index: usize, sum: DVec3, count: u32) {
+        self.sums[index] += sum;
+        self.counts[index] += count;
     }
 
-    /// Interleaved 8-bit RGB, top row first.
-    pub fn to_rgb8(&self, gamma: f32) -> Vec<u8> {
-        let mut out = Vec::with_capacity(self.pixels.len() * 3);
-        for p in &self.pixels {
-            for c in p.to_array() {
-                out.push(encode_channel(c, gamma));
-            }
+    /// The mean of every pixel's samples (black where there are none).
+    pub fn resolve(&self) -> Image {
+        let pixels = self
+            .sums
+            .iter()
+            .zip(&self.counts)
+            .map(|(s, &n)| match n {
+                0 => Color::ZERO,
+                1 => s.as_vec3().into(),
+                n => (*s / n as f64).as_vec3().into(),
+            })
+            .collect();
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels,
         }
-        out
     }
-}
-
-/// One channel of linear colour to a byte; NaN becomes 0.
-#[inline]
-pub fn encode_channel(c: f32, gamma: f32) -> u8 {
-    let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-    let c = if gamma == 1.0 { c } else { c.powf(1.0 / gamma) };
-    (255.0 * c).floor() as u8
 }
 
 #[cfg(test)]
@@ -52,12 +58,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn truncates_clamps_and_applies_gamma() {
-        assert_eq!(encode_channel(0.25, 1.0), 63); // 63.75 truncated
-        assert_eq!(encode_channel(1.0, 1.0), 255);
-        assert_eq!(encode_channel(7.0, 1.0), 255);
-        assert_eq!(encode_channel(-1.0, 1.0), 0);
-        assert_eq!(encode_channel(f32::NAN, 1.0), 0);
-        assert_eq!(encode_channel(0.25, 2.0), 127); // sqrt(0.25) = 0.5 → 127.5
+    fn sums_resolve_to_means() {
+        let mut f = Film::new(2, 1);
+        f.add(0, DVec3::new(1.0, 2.0, 3.0), 1);
+        f.add(0, DVec3::new(1.0, 0.0, 1.0), 3);
+        let img = f.resolve();
+        assert_eq!(img.pixels[0], Color::new(0.5, 0.5, 1.0));
+        assert_eq!(img.pixels[1], Color::ZERO);
     }
 }

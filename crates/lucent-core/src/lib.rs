@@ -18,7 +18,7 @@
 //! | 5 shading and lights | [`shading`], [`light`], [`camera`] |
 //! | 6 scene | [`scene`] |
 //! | 7 integrators | [`integrator`] |
-//! | 8 render loop and film | [`render`], [`film`] |
+//! | 8 render loop and film | [`render`], [`film`], [`image`] |
 
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -48,4 +48,5 @@ pub mod scene;
 pub mod integrator;
 
 pub mod film;
+pub mod image;
 pub mod render;

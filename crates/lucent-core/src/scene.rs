@@ -10,7 +10,9 @@ use crate::hit::{Hit, SurfacePoint};
 use crate::light::Light;
 use crate::math::Vec3A;
 use crate::ray::Ray;
+use crate::shading::bsdf::Bsdf;
 use crate::shading::material::Material;
+use crate::shading::surface;
 use crate::shading::texture::{EnvironmentMap, Texture};
 
 pub struct Scene {
@@ -77,6 +79,14 @@ impl Scene {
     /// `∂p/∂u`, `∂p/∂v` at the hit (bump mapping asks for them).
     pub fn tangents(&self, hit: &Hit, ray: &Ray) -> (Vec3A, Vec3A) {
         self.geometry.tangents(hit, ray.origin, ray.dir)
+    }
+
+    /// The BSDF of an ordinary (not emitting) surface point `sp` of `hit`: the
+    /// material's model around the bump-mapped normal, with the textured diffuse colour.
+    pub fn bsdf(&self, hit: &Hit, ray: &Ray, sp: &SurfacePoint) -> Bsdf {
+        let m = &self.materials[sp.material as usize];
+        let shaded = surface::shade(m, &self.textures, sp, || self.tangents(hit, ray));
+        m.bsdf(shaded.normal, shaded.diffuse)
     }
 
     pub fn accel_kind(&self) -> AccelKind {

@@ -61,7 +61,7 @@ pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnosti
 }
 
 /// Encodes the film in the output's format and writes it (atomically for a file).
-pub fn write_image(out: &Output, film: &lucent_core::film::Film, gamma: f32) -> Result<(), String> {
+pub fn write_image(out: &Output, film: &lucent_core::image::Image, gamma: f32) -> Result<(), String> {
     let (w, h) = (film.width, film.height);
     let bytes = match out.format {
         Format::Exr => encode_exr(w, h, &film.to_rgb_f32()),

@@ -1,4 +1,4 @@
-//! `lucent render SCENE [-o OUT.png] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
+//! `lucent render SCENE [-o OUT.png] [--spp N] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
 
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -7,6 +7,7 @@ use std::time::Instant;
 use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_core::integrator::whitted::MAX_PENDING;
+use lucent_core::render::job::RenderJob;
 use lucent_io::resources::input::FileId;
 use lucent_io::resources::Budget;
 use lucent_io::session::{Renderer, Session, SessionOptions};
@@ -27,6 +28,9 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores). The image is the same for any count.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
+    /// Samples per pixel, instead of the scene's `spp` (as pbrt's --spp).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
     /// Acceleration structure.
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
@@ -94,8 +98,11 @@ pub fn run(args: &RenderArgs) -> u8 {
         Ok(r) => r,
         Err(code) => return code,
     };
-    let job = built.job();
-    let progress = Progress::new(job.pixels.pixels(), args.quiet);
+    let job = match args.spp {
+        Some(spp) => RenderJob::whole(built.settings.resolution, spp),
+        None => built.job(),
+    };
+    let progress = Progress::new(job.pixels.pixels() * job.samples.len() as u64, args.quiet);
     let cancel = signals::cancel_flag();
     let t_render = Instant::now();
     let rendered = renderer.render(built, &job, &|n| progress.advance(n), cancel);
@@ -124,7 +131,7 @@ pub fn run(args: &RenderArgs) -> u8 {
         eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
         return EXIT_BAD_INPUT;
     }
-    if let Err(e) = crate::output::write_image(&out, &film, built.settings.gamma) {
+    if let Err(e) = crate::output::write_image(&out, &film.resolve(), built.settings.gamma) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }

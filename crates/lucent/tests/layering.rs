@@ -32,6 +32,7 @@ const CORE: Floors = &[
     ("integrator", 7),
     ("render", 8),
     ("film", 8),
+    ("image", 8),
 ];
 
 const IO: Floors = &[

@@ -1,7 +1,13 @@
-//! Integrators: how the colour seen along a camera ray is computed. One file each;
-//! the render loop only knows this trait.
+//! Integrators: how the colour seen along a camera ray is computed. One file each —
+//! [`whitted`] (`raytracer`), [`analytic_direct`], [`direct`], [`path`] (`pathtracer`) —
+//! and [`light_sampling`], the direct-lighting estimators the last two share. The render
+//! loop only knows this trait.
 
+pub mod analytic_direct;
 pub mod depth;
+pub mod direct;
+pub mod light_sampling;
+pub mod path;
 pub mod whitted;
 
 use crate::math::Color;
@@ -18,8 +24,25 @@ pub struct TraceCounts {
     pub cut_branches: u64,
 }
 
+/// Where in its pixel each camera sample goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelSampling {
+    /// The Whitted ray tracer's antialiasing (EXTENSIONS.md): one sample through the
+    /// centre; more on a jittered √spp × √spp grid when spp is a square, uniform
+    /// otherwise.
+    Stratified,
+    /// The Monte Carlo integrators (SCENE_FORMAT.md §4.1): sample 0 through the centre,
+    /// every other one at a uniform random point — sample i is the same whatever the
+    /// total, so more samples can be added to a finished render.
+    CentreThenUniform,
+}
+
 pub trait Integrator: Sync {
     /// Radiance arriving along `ray`; `sampler` gives the sample's random numbers, and
     /// `counts` counts what was traced on the way.
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color;
+
+    fn pixel_sampling(&self) -> PixelSampling {
+        PixelSampling::Stratified
+    }
 }

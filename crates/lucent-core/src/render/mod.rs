@@ -4,8 +4,9 @@
 //! order its tile ran — so the output is the same bytes for any thread count, and a crop
 //! is exactly that part of the whole image.
 //!
-//! The path of one pixel: [`render`] → `render_tile` → [`Camera::ray`] through the pixel
-//! centre → [`Integrator::radiance`] → the film.
+//! The path of one pixel: [`render`] → `render_tile` → for each sample, a point of the
+//! pixel ([`PixelSampling`]) → [`Camera::ray`] → [`Integrator::radiance`] → the sum of
+//! its samples on the film.
 //!
 //! [`Camera::ray`]: crate::camera::Camera::ray
 
@@ -16,8 +17,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::film::Film;
-use crate::integrator::{Integrator, TraceCounts};
-use crate::math::Color;
+use crate::integrator::{Integrator, PixelSampling, TraceCounts};
+use crate::math::DVec3;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
 use job::RenderJob;
@@ -42,8 +43,9 @@ pub struct RenderStats {
     pub cut_branches: u64,
 }
 
-/// Hooks for the caller: `progress` is called after each tile with the number of pixels
-/// it finished; when `cancel` becomes true the remaining tiles are skipped.
+/// Hooks for the caller: `progress` is called after each tile with the number of samples
+/// it took (pixels × samples per pixel); when `cancel` becomes true the remaining tiles
+/// are skipped.
 pub struct RenderControl<'a> {
     pub progress: &'a (dyn Fn(u64) + Sync),
     pub cancel: &'a AtomicBool,
@@ -83,14 +85,19 @@ pub fn render(
         })
         .collect();
 
-    let results: Vec<Option<(Vec<Color>, RenderStats)>> = tiles
+    // The tiles are taken in an order drawn once (the same for every render), so that
+    // any stretch of the render is a fair sample of the picture's cost and the ETA that
+    // the progress callback's rate gives is honest from the first tiles on; where a
+    // tile's pixels land does not depend on it.
+    let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
+    let results: Vec<Option<(Vec<DVec3>, RenderStats)>> = order
         .par_iter()
-        .map(|tile| {
+        .map(|&t| {
             if control.cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let out = render_tile(scene, integrator, job, tile, control.cancel)?;
-            (control.progress)(out.0.len() as u64);
+            let out = render_tile(scene, integrator, job, &tiles[t as usize], control.cancel)?;
+            (control.progress)(out.0.len() as u64 * job.samples.len() as u64);
             Some(out)
         })
         .collect();
@@ -98,34 +105,38 @@ pub fn render(
     let w = rect.width() as usize;
     let mut film = Film::new(rect.width(), rect.height());
     let mut stats = RenderStats::default();
-    for (tile, result) in tiles.iter().zip(results) {
+    for (&t, result) in order.iter().zip(results) {
+        let tile = &tiles[t as usize];
         let (pixels, s) = result?;
         stats.rays += s.rays;
         stats.bad_samples += s.bad_samples;
         stats.cut_branches += s.cut_branches;
         let tw = (tile.x1 - tile.x0) as usize;
+        let taken = job.samples.len() as u32;
         for (row, chunk) in pixels.chunks(tw).enumerate() {
             let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
-            film.pixels[start..start + tw].copy_from_slice(chunk);
+            for (i, sum) in chunk.iter().enumerate() {
+                film.add(start + i, *sum, taken);
+            }
         }
     }
     Some((film, stats))
 }
 
-/// The pixels of one tile; `None` as soon as `cancel` is set (it is looked at between
-/// pixels and every [`CANCEL_EVERY`] samples).
+/// The sums of the samples of one tile's pixels; `None` as soon as `cancel` is set (it
+/// is looked at between pixels and every [`CANCEL_EVERY`] samples).
 fn render_tile(
     scene: &Scene,
     integrator: &dyn Integrator,
     job: &RenderJob,
     tile: &Tile,
     cancel: &AtomicBool,
-) -> Option<(Vec<Color>, RenderStats)> {
+) -> Option<(Vec<DVec3>, RenderStats)> {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
     let n = job.spp.max(1);
-    let taken = job.samples.len() as u32;
+    let sampling = integrator.pixel_sampling();
     // Shuffled lens strata need a table of `spp` entries: beyond MAX_LENS_STRATA samples
     // per pixel (where stratifying them no longer matters) lens samples are independent.
     let shuffle_lens = scene.camera.has_lens() && n <= MAX_LENS_STRATA;
@@ -135,19 +146,31 @@ fn render_tile(
             if shuffle_lens {
                 lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
             }
-            let mut sum = Color::ZERO;
+            let mut sum = DVec3::ZERO;
             for i in job.samples.clone() {
                 if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
                 }
                 let mut sampler = Sampler::new(job.seed, x, y, i);
-                // One sample goes through the pixel centre; more are jittered over the
-                // pixel (one per cell of a √n × √n grid when n is a square).
-                let (dx, dy) = if n == 1 {
-                    (0.5, 0.5)
-                } else {
-                    let (u, v) = sampler.uniform2();
-                    stratified(i, n, u, v)
+                let (dx, dy) = match sampling {
+                    // One sample goes through the pixel centre; more are jittered over
+                    // the pixel (one per cell of a √n × √n grid when n is a square).
+                    PixelSampling::Stratified if n == 1 => (0.5, 0.5),
+                    PixelSampling::Stratified => {
+                        let (u, v) = sampler.uniform2();
+                        stratified(i, n, u, v)
+                    }
+                    // The first sample through the centre, the others anywhere in the
+                    // pixel; the two numbers are drawn for every sample, so that the
+                    // integrator's numbers are the same dimensions for all.
+                    PixelSampling::CentreThenUniform => {
+                        let (u, v) = sampler.uniform2();
+                        if i == 0 {
+                            (0.5, 0.5)
+                        } else {
+                            (u, v)
+                        }
+                    }
                 };
                 let lens = if shuffle_lens {
                     // The lens strata in another order than the pixel's, so that where a
@@ -164,13 +187,13 @@ fn render_tile(
                     .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
                 let c = integrator.radiance(scene, &ray, &mut sampler, &mut counts);
                 if c.is_finite() {
-                    sum += c;
+                    // The box filter: every sample of the pixel counts the same.
+                    sum += c.as_dvec3();
                 } else {
                     bad_samples += 1;
                 }
             }
-            // The box filter: every sample of the pixel counts the same.
-            pixels.push(if taken == 1 { sum } else { sum / taken as f32 });
+            pixels.push(sum);
         }
     }
     let stats = RenderStats {

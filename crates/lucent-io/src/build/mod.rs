@@ -116,7 +116,7 @@ fn build_parts(
     let work = settings::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
     Some(Built {
         scene,
-        integrator: Box::new(integrator),
+        integrator: integrator.into_box(),
         settings: RenderSettings {
             resolution: Resolution { width, height },
             spp: desc.spp(),

@@ -1,35 +1,50 @@
 //! The integrator and what it is told: `integrator`, `maxdepth`, `lightsamples`,
-//! `lightstratify`; and the work a render of the scene asks for. Settings this version
-//! cannot honour are errors; settings only other integrators read are warnings; work no
-//! picture needs is a warning at the setting that asks for it.
+//! `lightstratify`, `nexteventestimation`, `russianroulette`, `importancesampling`; and
+//! the work a render of the scene asks for. Settings only other integrators read, and
+//! lights the chosen one cannot render, are warnings; work no picture needs is a
+//! warning at the setting that asks for it.
 
+use lucent_core::integrator::analytic_direct::AnalyticDirect;
 use lucent_core::integrator::depth::DepthControl;
+use lucent_core::integrator::direct::Direct;
+use lucent_core::integrator::path::{self, Nee, PathTracer, UNBOUNDED_SAFETY_CAP};
 use lucent_core::integrator::whitted::Whitted;
+use lucent_core::integrator::Integrator;
 use lucent_core::light::Light;
 use lucent_core::math::Color;
 use lucent_core::scene::Scene;
 
-use crate::desc::{Brdf, IntegratorKind, SceneDesc};
+use crate::desc::{Brdf, DirectionSampling, IntegratorKind, LightKind, NeeMode, SceneDesc};
 use crate::diag::{Diagnostics, Loc};
 
-/// `maxdepth -1` (unbounded) is capped here: a closed mirror box would never end.
+/// `maxdepth -1` (unbounded) is capped here when nothing else ends a path: a closed
+/// mirror box would never end.
 pub const UNBOUNDED_DEPTH_CAP: u32 = 100;
 
-/// The integrator the scene asks for, with its settings; its adaptive depth control is
-/// set once the scene is built ([`control_depth`]).
-pub fn integrator(desc: &SceneDesc, diags: &mut Diagnostics) -> Whitted {
-    check_integrator(desc, diags);
-    let max_depth = match desc.max_depth() {
-        -1 => {
-            let loc = desc.max_depth.as_ref().map(|d| d.loc).unwrap_or(desc.end);
-            diags.warning(
-                loc,
-                format!("maxdepth: -1 (unbounded) is capped at {UNBOUNDED_DEPTH_CAP} bounces"),
-            );
-            UNBOUNDED_DEPTH_CAP
+/// The integrator the scene asks for, with its settings.
+pub enum Chosen {
+    Whitted(Whitted),
+    AnalyticDirect(AnalyticDirect),
+    Direct(Direct),
+    PathTracer(PathTracer),
+}
+
+impl Chosen {
+    pub fn into_box(self) -> Box<dyn Integrator> {
+        match self {
+            Chosen::Whitted(i) => Box::new(i),
+            Chosen::AnalyticDirect(i) => Box::new(i),
+            Chosen::Direct(i) => Box::new(i),
+            Chosen::PathTracer(i) => Box::new(i),
         }
-        d => d as u32,
-    };
+    }
+}
+
+/// The integrator the scene asks for, with its settings; the Whitted integrator's
+/// adaptive depth control is set once the scene is built ([`control_depth`]).
+pub fn integrator(desc: &SceneDesc, diags: &mut Diagnostics) -> Chosen {
+    check_integrator(desc, diags);
+    let kind = desc.integrator();
     let light_samples = desc.light_samples();
     let light_stratify = desc.light_stratify();
     if light_stratify {
@@ -46,17 +61,61 @@ pub fn integrator(desc: &SceneDesc, diags: &mut Diagnostics) -> Whitted {
             );
         }
     }
-    Whitted {
-        max_depth,
-        light_samples,
-        light_stratify,
-        depth: DepthControl::off(),
+    let roulette = desc.russian_roulette.as_ref().is_some_and(|r| r.value);
+    let max_depth = match desc.max_depth() {
+        -1 if kind == IntegratorKind::PathTracer && roulette => None,
+        -1 => {
+            let loc = desc.max_depth.as_ref().map(|d| d.loc).unwrap_or(desc.end);
+            let why = if kind == IntegratorKind::PathTracer {
+                " (without Russian roulette)"
+            } else {
+                ""
+            };
+            diags.warning(
+                loc,
+                format!("maxdepth: -1 (unbounded) is capped at {UNBOUNDED_DEPTH_CAP} bounces{why}"),
+            );
+            Some(UNBOUNDED_DEPTH_CAP)
+        }
+        d => Some(d as u32),
+    };
+    match kind {
+        IntegratorKind::RayTracer => Chosen::Whitted(Whitted {
+            max_depth: max_depth.unwrap_or(UNBOUNDED_DEPTH_CAP),
+            light_samples,
+            light_stratify,
+            depth: DepthControl::off(),
+        }),
+        IntegratorKind::AnalyticDirect => Chosen::AnalyticDirect(AnalyticDirect),
+        IntegratorKind::Direct => Chosen::Direct(Direct {
+            light_samples,
+            light_stratify,
+        }),
+        IntegratorKind::PathTracer => Chosen::PathTracer(PathTracer {
+            max_depth,
+            nee: match desc.next_event_estimation.as_ref().map(|n| n.value) {
+                None | Some(NeeMode::Off) => Nee::Off,
+                Some(NeeMode::On) => Nee::On,
+                Some(NeeMode::Mis) => Nee::Mis,
+            },
+            russian_roulette: roulette,
+            sampling: match desc.importance_sampling.as_ref().map(|n| n.value) {
+                None | Some(DirectionSampling::Hemisphere) => path::DirectionSampling::Hemisphere,
+                Some(DirectionSampling::Cosine) => path::DirectionSampling::Cosine,
+                Some(DirectionSampling::Brdf) => path::DirectionSampling::Brdf,
+            },
+            light_samples,
+            light_stratify,
+        }),
     }
 }
 
-/// Sets the integrator's adaptive depth control from the built scene and its `gamma`.
-pub fn control_depth(whitted: &mut Whitted, scene: &Scene, gamma: f32) {
-    whitted.depth = DepthControl::for_scene(scene, gamma);
+/// Sets the Whitted integrator's adaptive depth control from the built scene and its
+/// `gamma`.
+pub fn control_depth(chosen: &mut Chosen, scene: &Scene, gamma: f32) {
+    if let Chosen::Whitted(whitted) = chosen {
+        whitted.depth = DepthControl::for_scene(scene, gamma);
+    }
 }
 
 /// A render's work: the rays it traces, about.
@@ -78,7 +137,51 @@ pub const ABSURD_RAYS_PER_PIXEL: f64 = (1u64 << 20) as f64;
 
 /// Estimates the work of rendering the whole image (`pixels` of them), and warns at the
 /// setting responsible when it is absurd.
-pub fn estimate_work(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, pixels: u64, diags: &mut Diagnostics) -> Work {
+pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u64, diags: &mut Diagnostics) -> Work {
+    let spp = desc.spp() as f64;
+    // (rays per sample, shadow rays per shading point)
+    let (per_sample, shadow) = match chosen {
+        Chosen::Whitted(w) => return estimate_whitted(desc, scene, w, pixels, diags),
+        Chosen::AnalyticDirect(_) => (1.0, 0.0),
+        Chosen::Direct(d) => {
+            let shadow = shadow_rays(scene, d.light_samples);
+            (1.0 + shadow, shadow)
+        }
+        Chosen::PathTracer(p) => {
+            // A path's segments (about the depth, or a few with Russian roulette) each
+            // with their shadow rays.
+            let segments = p.max_depth.map_or(8.0, |d| d as f64 + 1.0);
+            let shadow = match p.nee {
+                Nee::Off => 0.0,
+                Nee::On => shadow_rays(scene, p.light_samples),
+                Nee::Mis => 1.0,
+            };
+            (segments * (1.0 + shadow), shadow)
+        }
+    };
+    let depth = match chosen {
+        Chosen::PathTracer(p) => p.max_depth.unwrap_or(UNBOUNDED_SAFETY_CAP),
+        _ => 1,
+    };
+    let work = Work {
+        rays_per_pixel: spp * per_sample,
+        rays: spp * per_sample * pixels as f64,
+        depth,
+    };
+    warn_if_absurd(desc, &work, spp, shadow, depth, diags);
+    work
+}
+
+/// Shadow rays per shading point: `samples` per area light, one per delta light.
+fn shadow_rays(scene: &Scene, samples: u32) -> f64 {
+    scene
+        .lights
+        .iter()
+        .map(|l| if l.is_delta() { 1.0 } else { samples as f64 })
+        .sum()
+}
+
+fn estimate_whitted(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, pixels: u64, diags: &mut Diagnostics) -> Work {
     let m = &scene.materials;
     let reflects = m
         .iter()
@@ -114,6 +217,11 @@ pub fn estimate_work(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, pixels:
         rays: spp * per_sample * pixels as f64,
         depth,
     };
+    warn_if_absurd(desc, &work, spp, shadow, depth, diags);
+    work
+}
+
+fn warn_if_absurd(desc: &SceneDesc, work: &Work, spp: f64, shadow: f64, depth: u32, diags: &mut Diagnostics) {
     if work.rays > ABSURD_RAYS || work.rays_per_pixel > ABSURD_RAYS_PER_PIXEL {
         let (loc, what) = culprit(desc, spp, shadow, depth);
         diags.warning(
@@ -130,7 +238,6 @@ pub fn estimate_work(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, pixels:
             ),
         );
     }
-    work
 }
 
 /// The setting that contributes the largest factor to the work, and its name.
@@ -152,39 +259,75 @@ fn culprit(desc: &SceneDesc, spp: f64, shadow: f64, depth: u32) -> (Loc, &'stati
     }
 }
 
+/// Warnings for what the chosen integrator does not use: switches of other integrators,
+/// lights it cannot render, BRDF models it does not shade with.
 fn check_integrator(desc: &SceneDesc, diags: &mut Diagnostics) {
-    if let Some(i) = &desc.integrator {
-        if i.value != IntegratorKind::RayTracer {
-            diags.error(
-                i.loc,
-                format!(
-                    "integrator: '{}' is not implemented yet (this version renders 'raytracer')",
-                    i.value.name()
-                ),
-            );
-            return;
+    let kind = desc.integrator();
+    let name = kind.name();
+    let unused = |what: &str, loc, diags: &mut Diagnostics| {
+        diags.warning(loc, format!("{what}: has no effect with integrator {name}"));
+    };
+    if kind != IntegratorKind::PathTracer {
+        if let Some(v) = &desc.next_event_estimation {
+            unused("nexteventestimation", v.loc, diags);
+        }
+        if let Some(v) = &desc.russian_roulette {
+            unused("russianroulette", v.loc, diags);
+        }
+        if let Some(v) = &desc.importance_sampling {
+            unused("importancesampling", v.loc, diags);
         }
     }
-    let only_for = |name: &str, loc, diags: &mut Diagnostics| {
-        diags.warning(loc, format!("{name}: has no effect with integrator raytracer"));
+    let nee = desc.next_event_estimation.as_ref().map(|n| n.value);
+    let samples_unused = match kind {
+        IntegratorKind::AnalyticDirect => true,
+        IntegratorKind::PathTracer => nee != Some(NeeMode::On),
+        _ => false,
     };
-    if let Some(v) = &desc.next_event_estimation {
-        only_for("nexteventestimation", v.loc, diags);
+    if samples_unused {
+        let why = if kind == IntegratorKind::PathTracer {
+            " (only 'nexteventestimation on' reads it)"
+        } else {
+            ""
+        };
+        if let Some(v) = &desc.light_samples {
+            diags.warning(
+                v.loc,
+                format!("lightsamples: has no effect with integrator {name}{why}"),
+            );
+        }
+        if let Some(v) = &desc.light_stratify {
+            diags.warning(
+                v.loc,
+                format!("lightstratify: has no effect with integrator {name}{why}"),
+            );
+        }
     }
-    if let Some(v) = &desc.russian_roulette {
-        only_for("russianroulette", v.loc, diags);
+    if matches!(kind, IntegratorKind::RayTracer | IntegratorKind::AnalyticDirect) {
+        if let Some(s) = desc
+            .shapes
+            .iter()
+            .find(|s| desc.materials[s.material as usize].brdf == Brdf::Ggx)
+        {
+            let how = if kind == IntegratorKind::RayTracer {
+                "it shades with Blinn-Phong"
+            } else {
+                "it shades the diffuse term only"
+            };
+            diags.warning(s.loc, format!("brdf ggx has no effect with integrator {name} ({how})"));
+        }
     }
-    if let Some(v) = &desc.importance_sampling {
-        only_for("importancesampling", v.loc, diags);
-    }
-    if let Some(s) = desc
-        .shapes
-        .iter()
-        .find(|s| desc.materials[s.material as usize].brdf == Brdf::Ggx)
-    {
-        diags.warning(
-            s.loc,
-            "brdf ggx has no effect with integrator raytracer (it shades with Blinn-Phong)",
-        );
+    if kind == IntegratorKind::AnalyticDirect {
+        for l in &desc.lights {
+            let what = match l.kind {
+                LightKind::Directional { .. } => "directional",
+                LightKind::Point { .. } => "point",
+                LightKind::Quad { .. } => continue,
+            };
+            diags.warning(
+                l.loc,
+                format!("{what}: integrator analyticdirect renders quad lights only; this light is ignored"),
+            );
+        }
     }
 }

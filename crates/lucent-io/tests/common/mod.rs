@@ -37,13 +37,13 @@ impl Drop for TempDir {
 
 /// Parses, builds and renders `text` (as the scene file `scene`, for relative file
 /// names) with `threads` worker threads; panics with the diagnostics on any error.
-/// Returns the film and the scene's `gamma`.
+/// Returns the resolved image and the scene's `gamma`.
 pub fn render_scene(
     scene: &str,
     text: &str,
     accel: lucent_core::accel::AccelKind,
     threads: usize,
-) -> (lucent_core::film::Film, f32) {
+) -> (lucent_core::image::Image, f32) {
     use lucent_io::session::{Renderer, Session, SessionOptions};
     let mut session = Session::parse_text(
         scene,
@@ -66,7 +66,7 @@ pub fn render_scene(
     let renderer = Renderer::new(Some(threads)).unwrap();
     let cancel = std::sync::atomic::AtomicBool::new(false);
     let (film, _) = renderer.render(built, &built.job(), &|_| {}, &cancel).unwrap();
-    (film, built.settings.gamma)
+    (film.resolve(), built.settings.gamma)
 }
 
 /// Renders the job the scene asks for, changed by `edit` (a crop, a sample range, a
@@ -75,7 +75,7 @@ pub fn render_job(
     scene: &str,
     text: &str,
     edit: impl FnOnce(&mut lucent_core::render::job::RenderJob),
-) -> lucent_core::film::Film {
+) -> lucent_core::image::Image {
     use lucent_io::session::{Renderer, Session, SessionOptions};
     let mut session = Session::parse_text(scene, text.as_bytes(), SessionOptions::default());
     session.build();
@@ -87,7 +87,7 @@ pub fn render_job(
     edit(&mut job);
     let cancel = std::sync::atomic::AtomicBool::new(false);
     let renderer = Renderer::new(Some(2)).unwrap();
-    renderer.render(built, &job, &|_| {}, &cancel).unwrap().0
+    renderer.render(built, &job, &|_| {}, &cancel).unwrap().0.resolve()
 }
 
 /// [`render_scene`] as 8-bit RGB.

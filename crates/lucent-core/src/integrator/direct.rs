@@ -1,0 +1,58 @@
+//! Scene commands `integrator direct`, `lightsamples N`, `lightstratify on|off` (CSE168
+//! homework 2, SCENE_FORMAT.md §4.5): light that reaches the camera after exactly one
+//! reflection, estimated with `lightsamples` shadow rays per area light:
+//!
+//! ```text
+//! L = E + Σ_lights (1/N) Σ_m f(x, ωi, ωo) · V(x, y_m) · max(n·ωi, 0) · Le / pdf(ωi)
+//! ```
+//!
+//! with `pdf = R² / (A · cos θ_light)` (a uniform point `y_m` on the parallelogram, on a
+//! √N × √N jittered grid with `lightstratify on`) and `f` the material's BRDF. Point and
+//! directional lights get one shadow ray each. No ambient term. A camera ray that hits a
+//! light sees its radiance from the front and black from behind.
+
+use super::light_sampling::every_light;
+use super::{Integrator, PixelSampling, TraceCounts};
+use crate::hit::BACKGROUND;
+use crate::math::Color;
+use crate::ray::Ray;
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+
+pub struct Direct {
+    /// `lightsamples`.
+    pub light_samples: u32,
+    /// `lightstratify`.
+    pub light_stratify: bool,
+}
+
+impl Integrator for Direct {
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
+        counts.rays += 1;
+        let Some(hit) = scene.closest_hit(ray) else {
+            return BACKGROUND;
+        };
+        let sp = scene.surface_point(&hit, ray);
+        if let Some(light) = sp.light {
+            return scene.lights[light as usize].radiance_seen(ray.dir, sp.normal);
+        }
+        let bsdf = scene.bsdf(&hit, ray, &sp);
+        let emission = scene.materials[sp.material as usize].emission;
+        let wo = -ray.dir;
+        emission
+            + every_light(
+                scene,
+                sp.point,
+                wo,
+                &bsdf,
+                self.light_samples,
+                self.light_stratify,
+                sampler,
+                counts,
+            )
+    }
+
+    fn pixel_sampling(&self) -> PixelSampling {
+        PixelSampling::CentreThenUniform
+    }
+}

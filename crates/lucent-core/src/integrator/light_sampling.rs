@@ -1,0 +1,100 @@
+//! Direct lighting at a surface point, shared by the `direct` integrator and the path
+//! tracer's next-event estimation: the estimator of SCENE_FORMAT.md §4.5 (`lightsamples`
+//! points on every light, stratified with `lightstratify on`) and the light half of
+//! multiple importance sampling (§4.6: one light chosen uniformly, weighted by the power
+//! heuristic against the BSDF strategy's density).
+
+use super::TraceCounts;
+use crate::light::LightSample;
+use crate::math::{Color, Vec3A};
+use crate::ray::{Ray, EPSILON};
+use crate::sampler::{stratified, Sampler};
+use crate::sampling::mis::power_heuristic;
+use crate::scene::Scene;
+use crate::shading::bsdf::Bsdf;
+
+/// Whether nothing blocks the segment from `x` to the light sample (a shadow ray that
+/// stops ε short of the sampled point).
+#[inline]
+pub fn unoccluded(scene: &Scene, x: Vec3A, s: &LightSample, counts: &mut TraceCounts) -> bool {
+    counts.rays += 1;
+    let shadow = Ray::segment(x, s.wi, EPSILON, s.distance - EPSILON);
+    !scene.occluded(&shadow)
+}
+
+/// `f · max(n·wi, 0) · Li / pdf` of one light sample, before visibility; zero when the
+/// light is behind the surface or the BSDF sends nothing that way.
+#[inline]
+fn unshadowed(bsdf: &Bsdf, wo: Vec3A, s: &LightSample) -> Color {
+    let cos = bsdf.normal().dot(s.wi);
+    if !(cos > 0.0) {
+        return Color::ZERO;
+    }
+    bsdf.eval(wo, s.wi) * s.radiance * (cos / s.pdf)
+}
+
+/// §4.5: the light arriving at `x` (toward `wo`) from every light, `samples` points on
+/// each area light (on a √N × √N jittered grid with `stratify`), one ray to each delta
+/// light.
+pub fn every_light(
+    scene: &Scene,
+    x: Vec3A,
+    wo: Vec3A,
+    bsdf: &Bsdf,
+    samples: u32,
+    stratify: bool,
+    sampler: &mut Sampler,
+    counts: &mut TraceCounts,
+) -> Color {
+    let mut total = Color::ZERO;
+    for light in &scene.lights {
+        let n = if light.is_delta() { 1 } else { samples.max(1) };
+        let mut sum = Color::ZERO;
+        for k in 0..n {
+            let (u, v) = sampler.uniform2();
+            let (u, v) = if stratify { stratified(k, n, u, v) } else { (u, v) };
+            let Some(s) = light.sample_li(x, u, v) else { continue };
+            let c = unshadowed(bsdf, wo, &s);
+            if c != Color::ZERO && unoccluded(scene, x, &s, counts) {
+                sum += c;
+            }
+        }
+        total += sum / n as f32;
+    }
+    total
+}
+
+/// §4.6, MIS: one light chosen uniformly, one point on it, weighted against the BSDF
+/// strategy whose density for a direction is `bsdf_pdf`.
+pub fn one_light_mis(
+    scene: &Scene,
+    x: Vec3A,
+    wo: Vec3A,
+    bsdf: &Bsdf,
+    bsdf_pdf: impl Fn(Vec3A) -> f32,
+    sampler: &mut Sampler,
+    counts: &mut TraceCounts,
+) -> Color {
+    let count = scene.lights.len();
+    let pick = sampler.uniform();
+    let (u, v) = sampler.uniform2();
+    if count == 0 {
+        return Color::ZERO;
+    }
+    let light = &scene.lights[((pick * count as f32) as usize).min(count - 1)];
+    let Some(mut s) = light.sample_li(x, u, v) else {
+        return Color::ZERO;
+    };
+    // The density of choosing this light and this point on it.
+    s.pdf /= count as f32;
+    let weight = if s.is_delta {
+        1.0
+    } else {
+        power_heuristic(s.pdf, bsdf_pdf(s.wi))
+    };
+    let c = unshadowed(bsdf, wo, &s);
+    if c == Color::ZERO || !unoccluded(scene, x, &s, counts) {
+        return Color::ZERO;
+    }
+    c * weight
+}

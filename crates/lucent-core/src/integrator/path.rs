@@ -1,0 +1,218 @@
+//! Scene commands `integrator pathtracer`, `maxdepth N`, `nexteventestimation
+//! off|on|mis`, `russianroulette on|off`, `importancesampling hemisphere|cosine|brdf`
+//! (CSE168 homeworks 3 and 4, SCENE_FORMAT.md §4.6).
+//!
+//! The camera ray is segment 0; it hits x1; scattering at x_k makes segment k, which
+//! hits x_{k+1}. β is the throughput, the product of `f · cos θ / pdf` of the scattering
+//! events so far. A path that hits a light ends there. `maxdepth` N bounds the number of
+//! scattering events (−1: unbounded, ended by Russian roulette):
+//!
+//! - **`off`**: a light hit by any segment adds `β · Le` (its front; its back is black);
+//!   every ordinary hit adds `β · E` and scatters while k ≤ N.
+//! - **`on`**: a light adds `Le` only when the camera sees it; every ordinary hit x_k with
+//!   k ≤ N adds `β · (E + L_direct)` (the `direct` integrator's estimator, with
+//!   `lightsamples` and `lightstratify`) and scatters while k < N.
+//! - **`mis`**: at x_k (k ≤ N), one light sample and one BSDF sample, weighted by the
+//!   power heuristic; the BSDF sample is also the direction the path goes on in (while
+//!   k < N), and a light it finds adds its weighted share, nothing more.
+//!
+//! Directions are drawn uniformly on the hemisphere around the shading normal, in
+//! proportion to the cosine, or from the BSDF (`importancesampling`); one below the
+//! surface ends the path. Russian roulette, when about to go on, ends the path with
+//! probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
+
+use super::light_sampling::{every_light, one_light_mis};
+use super::{Integrator, PixelSampling, TraceCounts};
+use crate::math::{Color, Vec3A};
+use crate::ray::Ray;
+use crate::sampler::Sampler;
+use crate::sampling::frame::Frame;
+use crate::sampling::mis::power_heuristic;
+use crate::sampling::warp;
+use crate::scene::Scene;
+use crate::shading::bsdf::Bsdf;
+
+/// `nexteventestimation`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Nee {
+    Off,
+    On,
+    Mis,
+}
+
+/// `importancesampling`: where the next direction of a path comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DirectionSampling {
+    Hemisphere,
+    Cosine,
+    Brdf,
+}
+
+/// Scattering events of a path with no depth limit, at most: only a path whose
+/// throughput never drops (white, lossless walls) gets there, where Russian roulette
+/// would never end it.
+pub const UNBOUNDED_SAFETY_CAP: u32 = 1 << 12;
+
+pub struct PathTracer {
+    /// `maxdepth`: scattering events, `None` for −1 (unbounded).
+    pub max_depth: Option<u32>,
+    pub nee: Nee,
+    pub russian_roulette: bool,
+    pub sampling: DirectionSampling,
+    /// `lightsamples` and `lightstratify` for `nexteventestimation on`.
+    pub light_samples: u32,
+    pub light_stratify: bool,
+}
+
+/// A direction drawn for the path to go on in, with `f`, the cosine at the surface and
+/// the density.
+struct Bounce {
+    wi: Vec3A,
+    f: Color,
+    cos: f32,
+    pdf: f32,
+}
+
+impl PathTracer {
+    /// The density with which [`PathTracer::bounce`] draws `wi`.
+    fn direction_pdf(&self, bsdf: &Bsdf, wo: Vec3A, wi: Vec3A) -> f32 {
+        let cos = bsdf.normal().dot(wi);
+        match self.sampling {
+            DirectionSampling::Hemisphere => warp::uniform_hemisphere_pdf(cos),
+            DirectionSampling::Cosine => warp::cosine_hemisphere_pdf(cos),
+            DirectionSampling::Brdf => bsdf.pdf(wo, wi),
+        }
+    }
+
+    /// The next direction, or `None` when the path ends (nothing drawn, or a direction
+    /// below the surface).
+    fn bounce(&self, bsdf: &Bsdf, wo: Vec3A, sampler: &mut Sampler) -> Option<Bounce> {
+        let n = bsdf.normal();
+        let pick = sampler.uniform();
+        let (u, v) = sampler.uniform2();
+        let (wi, f, pdf) = match self.sampling {
+            DirectionSampling::Hemisphere => {
+                let wi = Frame::around(n).to_world(warp::uniform_hemisphere(u, v));
+                (wi, bsdf.eval(wo, wi), warp::uniform_hemisphere_pdf(n.dot(wi)))
+            }
+            DirectionSampling::Cosine => {
+                let wi = Frame::around(n).to_world(warp::cosine_hemisphere(u, v));
+                (wi, bsdf.eval(wo, wi), warp::cosine_hemisphere_pdf(n.dot(wi)))
+            }
+            DirectionSampling::Brdf => {
+                let s = bsdf.sample(wo, pick, u, v)?;
+                (s.wi, s.f, s.pdf)
+            }
+        };
+        let cos = n.dot(wi);
+        (cos > 0.0 && pdf > 0.0).then_some(Bounce { wi, f, cos, pdf })
+    }
+
+    /// Whether scattering event `k` (at x_k) may happen.
+    #[inline]
+    fn within_depth(&self, k: u32) -> bool {
+        match self.max_depth {
+            Some(n) => k <= n,
+            None => k <= UNBOUNDED_SAFETY_CAP,
+        }
+    }
+}
+
+impl Integrator for PathTracer {
+    fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
+        let mut total = Color::ZERO;
+        let mut beta = Color::ONE;
+        let mut ray = *camera_ray;
+        // The density of the BSDF strategy for the segment being traced (MIS weighs a
+        // light it finds against the light strategy); None for the camera segment.
+        let mut bsdf_pdf: Option<f32> = None;
+        // The index of the vertex the current segment will hit.
+        let mut k = 1u32;
+        loop {
+            counts.rays += 1;
+            let Some(hit) = scene.closest_hit(&ray) else {
+                break; // the background is black
+            };
+            let sp = scene.surface_point(&hit, &ray);
+            if let Some(index) = sp.light {
+                let le = scene.lights[index as usize].radiance_seen(ray.dir, sp.normal);
+                match (self.nee, bsdf_pdf) {
+                    (Nee::Off, _) | (_, None) => total += beta * le,
+                    (Nee::On, Some(_)) => {} // next-event estimation counted it
+                    (Nee::Mis, Some(p_bsdf)) => {
+                        if le != Color::ZERO {
+                            let light = &scene.lights[index as usize];
+                            let p_light = match light {
+                                crate::light::Light::Quad(q) => q.pdf_li(hit.t, ray.dir),
+                                _ => 0.0,
+                            } / scene.lights.len() as f32;
+                            total += beta * le * power_heuristic(p_bsdf, p_light);
+                        }
+                    }
+                }
+                break;
+            }
+            let within = self.within_depth(k);
+            // Past the last scattering event only the path without NEE looks at a hit.
+            if !within && self.nee != Nee::Off {
+                break;
+            }
+            let m = &scene.materials[sp.material as usize];
+            total += beta * m.emission;
+            if !within {
+                break;
+            }
+            let bsdf = scene.bsdf(&hit, &ray, &sp);
+            let wo = -ray.dir;
+            match self.nee {
+                Nee::Off => {}
+                Nee::On => {
+                    total += beta
+                        * every_light(
+                            scene,
+                            sp.point,
+                            wo,
+                            &bsdf,
+                            self.light_samples,
+                            self.light_stratify,
+                            sampler,
+                            counts,
+                        );
+                }
+                Nee::Mis => {
+                    let pdf = |wi| self.direction_pdf(&bsdf, wo, wi);
+                    total += beta * one_light_mis(scene, sp.point, wo, &bsdf, pdf, sampler, counts);
+                }
+            }
+            // With NEE the last scattering event's light is already counted; MIS still
+            // traces its BSDF sample to find the light that strategy weighs.
+            let last = !self.within_depth(k + 1);
+            if last && self.nee == Nee::On {
+                break;
+            }
+            let Some(b) = self.bounce(&bsdf, wo, sampler) else {
+                break;
+            };
+            beta *= b.f * (b.cos / b.pdf);
+            if self.russian_roulette && !last {
+                let q = 1.0 - beta.max_element().min(1.0);
+                let u = sampler.uniform();
+                if u < q {
+                    break;
+                }
+                beta /= 1.0 - q;
+            }
+            if !beta.is_finite() || beta == Color::ZERO {
+                break;
+            }
+            ray = Ray::new(sp.point, b.wi);
+            bsdf_pdf = Some(b.pdf);
+            k += 1;
+        }
+        total
+    }
+
+    fn pixel_sampling(&self) -> PixelSampling {
+        PixelSampling::CentreThenUniform
+    }
+}
