@@ -62,6 +62,101 @@ pub fn read_rgb8(path: &Path) -> Result<Rgb8Image, String> {
     })
 }
 
+/// A linear RGB image read from disk (EXR or Radiance HDR), interleaved.
+pub struct RgbF32Image {
+    pub width: u32,
+    pub height: u32,
+    pub data: Vec<f32>,
+}
+
+/// Reads an EXR or HDR file (a regular file) as linear RGB floats.
+pub fn read_rgb_f32(path: &Path) -> Result<RgbF32Image, String> {
+    let bytes = read_input(path, MAX_IMAGE_BYTES, &mut Inputs::default())?;
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?;
+    let img = reader.decode().map_err(|e| e.to_string())?.to_rgb32f();
+    Ok(RgbF32Image {
+        width: img.width(),
+        height: img.height(),
+        data: img.into_raw(),
+    })
+}
+
+/// Whether two Monte Carlo renders of the same scene agree within their noise, in linear
+/// radiance: the image is cut into `cols × rows` regions, and in each the mean
+/// difference of every channel is divided by its standard error, estimated from the
+/// spread of the per-pixel differences in that region (the picture's own structure
+/// cancels in a difference; what is left is the two renders' noise). The largest |z| of
+/// the regions and of the whole image, and the ratio of the two images' means.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Agreement {
+    pub worst_z: f64,
+    /// (column, row, channel) of the worst region.
+    pub worst_at: (u32, u32, usize),
+    pub whole_z: f64,
+    pub mean_ratio: f64,
+}
+
+pub fn agreement(a: &RgbF32Image, b: &RgbF32Image, cols: u32, rows: u32) -> Option<Agreement> {
+    if (a.width, a.height) != (b.width, b.height) || a.width < cols || a.height < rows {
+        return None;
+    }
+    let (w, h) = (a.width as usize, a.height as usize);
+    // Per region and channel: n, Σd, Σd².
+    let mut stats = vec![(0f64, 0f64, 0f64); (cols * rows) as usize * 3];
+    let mut whole = [(0f64, 0f64, 0f64); 3];
+    let (mut sum_a, mut sum_b) = (0f64, 0f64);
+    for y in 0..h {
+        let ry = (y * rows as usize / h) as u32;
+        for x in 0..w {
+            let rx = (x * cols as usize / w) as u32;
+            for c in 0..3 {
+                let i = (y * w + x) * 3 + c;
+                let (va, vb) = (a.data[i] as f64, b.data[i] as f64);
+                let va = if va.is_finite() { va } else { 0.0 };
+                let vb = if vb.is_finite() { vb } else { 0.0 };
+                sum_a += va;
+                sum_b += vb;
+                let d = va - vb;
+                let s = &mut stats[((ry * cols + rx) as usize) * 3 + c];
+                *s = (s.0 + 1.0, s.1 + d, s.2 + d * d);
+                whole[c] = (whole[c].0 + 1.0, whole[c].1 + d, whole[c].2 + d * d);
+            }
+        }
+    }
+    let z = |(n, s, s2): (f64, f64, f64)| {
+        let mean = s / n;
+        let var = (s2 / n - mean * mean).max(0.0) * n / (n - 1.0);
+        let se = (var / n).sqrt();
+        if se > 0.0 {
+            mean / se
+        } else if mean == 0.0 {
+            0.0
+        } else {
+            f64::INFINITY
+        }
+    };
+    let mut worst = (0.0f64, (0, 0, 0));
+    for (k, s) in stats.iter().enumerate() {
+        let zk = z(*s);
+        if zk.abs() > worst.0.abs() || worst.0.is_nan() {
+            let region = (k / 3) as u32;
+            worst = (zk, (region % cols, region / cols, k % 3));
+        }
+    }
+    let whole_z = whole
+        .iter()
+        .map(|s| z(*s))
+        .fold(0.0f64, |m, v| if v.abs() > m.abs() { v } else { m });
+    Some(Agreement {
+        worst_z: worst.0,
+        worst_at: worst.1,
+        whole_z,
+        mean_ratio: if sum_b > 0.0 { sum_a / sum_b } else { f64::NAN },
+    })
+}
+
 /// How two images of the same size differ, on the 0–255 scale.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImageDiff {

@@ -63,6 +63,6 @@ impl Integrator for AnalyticDirect {
     }
 
     fn pixel_sampling(&self) -> PixelSampling {
-        PixelSampling::CentreThenUniform
+        PixelSampling::Uniform
     }
 }

@@ -53,6 +53,6 @@ impl Integrator for Direct {
     }
 
     fn pixel_sampling(&self) -> PixelSampling {
-        PixelSampling::CentreThenUniform
+        PixelSampling::Uniform
     }
 }

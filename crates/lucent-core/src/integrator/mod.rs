@@ -31,10 +31,13 @@ pub enum PixelSampling {
     /// centre; more on a jittered √spp × √spp grid when spp is a square, uniform
     /// otherwise.
     Stratified,
-    /// The Monte Carlo integrators (SCENE_FORMAT.md §4.1): sample 0 through the centre,
-    /// every other one at a uniform random point — sample i is the same whatever the
-    /// total, so more samples can be added to a finished render.
-    CentreThenUniform,
+    /// The Monte Carlo integrators (SCENE_FORMAT.md §4.1 allows it): with `spp 1` the
+    /// pixel centre, with more every sample at a uniform random point. Sample i is then
+    /// the same whatever the total (above 1), so more samples can be added to a render,
+    /// and the pixel's estimate is unbiased at any count — a first sample fixed at the
+    /// centre (§4.1's other reading) would weigh the centre 1/spp and add an error that
+    /// falls like 1/spp at edges.
+    Uniform,
 }
 
 pub trait Integrator: Sync {

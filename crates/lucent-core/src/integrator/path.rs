@@ -213,6 +213,6 @@ impl Integrator for PathTracer {
     }
 
     fn pixel_sampling(&self) -> PixelSampling {
-        PixelSampling::CentreThenUniform
+        PixelSampling::Uniform
     }
 }

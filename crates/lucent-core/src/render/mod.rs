@@ -160,12 +160,12 @@ fn render_tile(
                         let (u, v) = sampler.uniform2();
                         stratified(i, n, u, v)
                     }
-                    // The first sample through the centre, the others anywhere in the
-                    // pixel; the two numbers are drawn for every sample, so that the
-                    // integrator's numbers are the same dimensions for all.
-                    PixelSampling::CentreThenUniform => {
+                    // A single sample through the centre, more anywhere in the pixel; the
+                    // two numbers are drawn either way, so that the integrator's numbers
+                    // are the same dimensions for every sample.
+                    PixelSampling::Uniform => {
                         let (u, v) = sampler.uniform2();
-                        if i == 0 {
+                        if n == 1 {
                             (0.5, 0.5)
                         } else {
                             (u, v)

@@ -1,0 +1,285 @@
+//! The Monte Carlo integrators against answers known in closed form and against each
+//! other: a white furnace, `direct` against `analyticdirect`, the path tracer's
+//! next-event-estimation modes against each other, the 1/√spp fall of the error, MIS
+//! against its two strategies, and the same bytes for any thread count.
+//!
+//! Every comparison is in linear radiance (never 8-bit, whose clamp after averaging
+//! darkens noisier estimators), and every tolerance is stated with its reason.
+
+mod common;
+
+use common::render_scene;
+
+use lucent_core::accel::AccelKind;
+use lucent_core::image::Image;
+use lucent_io::image::{agreement, RgbF32Image};
+
+fn render(text: &str) -> Image {
+    render_scene("mc.test", text, AccelKind::Bvh, 2).0
+}
+
+/// Mean of one channel over the image and its standard error, from the spread of the
+/// pixels (each pixel is an independent estimate of the same radiance in a furnace).
+fn mean_and_error(img: &Image) -> (f64, f64) {
+    let v: Vec<f64> = img.pixels.iter().map(|p| p.x as f64).collect();
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// A closed cube around the camera, every triangle wound so its normal faces inside.
+fn inward_cube() -> String {
+    let mut s = String::from("maxverts 8\n");
+    let corners: Vec<[f64; 3]> = (0..8)
+        .map(|i| {
+            [
+                if i & 1 == 0 { -1.0 } else { 1.0 },
+                if i & 2 == 0 { -1.0 } else { 1.0 },
+                if i & 4 == 0 { -1.0 } else { 1.0 },
+            ]
+        })
+        .collect();
+    for c in &corners {
+        s += &format!("vertex {} {} {}\n", c[0], c[1], c[2]);
+    }
+    // Each face: the four corners with one coordinate fixed, as two triangles.
+    for axis in 0..3 {
+        for side in [0, 1] {
+            let quad: Vec<usize> = (0..8).filter(|i| (i >> axis) & 1 == side).collect();
+            // quad = [a, b, c, d] with a, d opposite.
+            for tri in [[quad[0], quad[1], quad[3]], [quad[0], quad[3], quad[2]]] {
+                let p = |i: usize| corners[i];
+                let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
+                let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+                let n = [
+                    e1[1] * e2[2] - e1[2] * e2[1],
+                    e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0],
+                ];
+                // Inside is toward the origin: the normal must point against the face's position.
+                let outward = n[axis] * if side == 1 { 1.0 } else { -1.0 } > 0.0;
+                if outward {
+                    s += &format!("tri {} {} {}\n", tri[0], tri[2], tri[1]);
+                } else {
+                    s += &format!("tri {} {} {}\n", tri[0], tri[1], tri[2]);
+                }
+            }
+        }
+    }
+    s
+}
+
+#[test]
+fn a_white_furnace_converges_to_its_closed_form_for_every_setting() {
+    // Walls of albedo ρ = 0.5 emitting E = 0.3 everywhere: L = E / (1 − ρ) = 0.6 for
+    // unbounded paths, E (1 − ρ^(N+1)) / (1 − ρ) with N scattering events.
+    // 16 × 16 pixels × 16 samples = 4,096 paths; the tolerance is 5 standard errors of the
+    // image mean (measured from the pixels' spread) and at most 3% — a wrong weight
+    // (a missing cosine, a pdf of the wrong lobe, Russian roulette without its division)
+    // is off by far more.
+    let settings = [
+        ("off", "hemisphere", "on", -1),
+        ("off", "cosine", "on", -1),
+        ("off", "brdf", "on", -1),
+        ("on", "cosine", "on", -1),
+        ("mis", "brdf", "on", -1),
+        ("mis", "hemisphere", "on", -1),
+        ("off", "cosine", "off", 3),
+        ("off", "hemisphere", "off", 0),
+    ];
+    for (nee, sampling, rr, depth) in settings {
+        let text = format!(
+            "size 16 16\nintegrator pathtracer\nspp 16\nmaxdepth {depth}\nrussianroulette {rr}\n\
+             nexteventestimation {nee}\nimportancesampling {sampling}\n\
+             camera 0 0 0  0 0 -1  0 1 0  90\nambient 0 0 0\ndiffuse 0.5 0.5 0.5\nemission 0.3 0.3 0.3\n{}",
+            inward_cube()
+        );
+        let want = if depth < 0 {
+            0.6
+        } else {
+            0.3 * (1.0 - 0.5f64.powi(depth + 1)) / 0.5
+        };
+        let (mean, se) = mean_and_error(&render(&text));
+        let off = (mean - want).abs();
+        assert!(
+            off <= 5.0 * se + 1e-6 && off <= 0.03 * want,
+            "nee {nee}, {sampling}, rr {rr}, maxdepth {depth}: {mean:.4} ± {se:.4}, want {want:.4}"
+        );
+        eprintln!("furnace nee {nee} {sampling} rr {rr} maxdepth {depth}: {mean:.4} ± {se:.4} (want {want:.4})");
+    }
+}
+
+/// SCENE_FORMAT.md §7.2: a floor under a quad light.
+fn floor_under_light(integrator: &str, extra: &str) -> String {
+    format!(
+        "size 160 120\nintegrator {integrator}\n{extra}\ncamera 0.0001 0 -4  0 0 0  0 1 0  45\nmaxverts 4\n\
+         vertex -10 -1 -10\nvertex -10 -1 10\nvertex 10 -1 -10\nvertex 10 -1 10\n\
+         diffuse 0.5 0.4 0.3\ntri 0 1 2\ntri 1 3 2\nquadLight -1 1 -1  0 0 2  2 0 0  4 4 4\n"
+    )
+}
+
+#[test]
+fn analytic_direct_gives_the_worked_example_and_direct_converges_to_it() {
+    let (img, gamma) = render_scene("a.test", &floor_under_light("analyticdirect", ""), AccelKind::Bvh, 2);
+    let bytes = img.to_rgb8(gamma);
+    let px = |row: usize, col: usize| {
+        let i = (row * 160 + col) * 3;
+        [bytes[i], bytes[i + 1], bytes[i + 2]]
+    };
+    // The table of §7.2.
+    assert_eq!(px(119, 80), [62, 49, 37]);
+    assert_eq!(px(119, 0), [41, 33, 24]);
+    assert_eq!(px(100, 80), [116, 92, 69]);
+    assert_eq!(px(90, 30), [52, 41, 31]);
+    assert_eq!(px(75, 80), [2, 2, 1]);
+    assert_eq!(px(25, 80), [255, 255, 255]);
+    assert_eq!(px(60, 80), [0, 0, 0]);
+
+    // `direct` with 100 stratified light samples, through the pixel centres like the
+    // analytic image: a stratified estimate of this smooth integrand has a relative
+    // noise of about 1% per pixel, so the mean over the lit floor (some 9,000 pixels)
+    // must agree within 1% and no pixel brighter than 0.05 may be off by more than 5%.
+    let direct = render(&floor_under_light("direct", "lightsamples 100\nlightstratify on"));
+    let (mut sa, mut sd, mut worst) = (0.0f64, 0.0f64, 0.0f32);
+    for (a, d) in img.pixels.iter().zip(&direct.pixels) {
+        if a.x > 0.05 && a.x < 1.0 {
+            sa += a.x as f64;
+            sd += d.x as f64;
+            worst = worst.max((d.x - a.x).abs() / a.x);
+        }
+    }
+    assert!((sd / sa - 1.0).abs() < 0.01, "mean ratio {}", sd / sa);
+    assert!(worst < 0.05, "worst pixel off by {worst}");
+}
+
+/// A small Cornell-like box: a white floor, back wall and ceiling, red and green side
+/// walls, a block, and a quad light below the ceiling.
+fn small_box(settings: &str, spp: u32) -> String {
+    format!(
+        "size 32 32\nintegrator pathtracer\nspp {spp}\n{settings}\ncamera 0 0 3.2  0 0 0  0 1 0  45\n\
+         maxverts 16\n\
+         vertex -1 -1 -1\nvertex 1 -1 -1\nvertex 1 1 -1\nvertex -1 1 -1\n\
+         vertex -1 -1 1\nvertex 1 -1 1\nvertex 1 1 1\nvertex -1 1 1\n\
+         ambient 0 0 0\ndiffuse 0.7 0.7 0.7\n\
+         tri 0 4 5\ntri 0 5 1\n\
+         tri 3 2 6\ntri 3 6 7\n\
+         tri 0 1 2\ntri 0 2 3\n\
+         diffuse 0.7 0.1 0.1\ntri 0 3 7\ntri 0 7 4\n\
+         diffuse 0.1 0.7 0.1\ntri 1 5 6\ntri 1 6 2\n\
+         diffuse 0.5 0.5 0.5\nspecular 0.3 0.3 0.3\nshininess 20\n\
+         pushTransform\ntranslate -0.3 -0.5 -0.2\nrotate 0 1 0 20\nscale 0.5 1 0.5\nsphere 0 0 0 0.5\npopTransform\n\
+         quadLight -0.3 0.99 -0.3  0 0 0.6  0.6 0 0  6 6 6\n"
+    )
+}
+
+fn as_rgb(img: &Image) -> RgbF32Image {
+    RgbF32Image {
+        width: img.width,
+        height: img.height,
+        data: img.pixels.iter().flat_map(|p| p.to_array()).collect(),
+    }
+}
+
+#[test]
+fn next_event_estimation_off_on_and_mis_converge_to_the_same_radiance() {
+    // maxdepth 3, every mode; z-scores of 8 × 6 regions' mean differences from the
+    // renders' own noise: below 5 for agreeing estimators (a false alarm about once in
+    // 10,000 comparisons), far above for a double-counted light (NEE plus the light
+    // found by the next segment adds its direct light twice: z in the tens).
+    let off = render(&small_box(
+        "maxdepth 3\nnexteventestimation off\nimportancesampling cosine",
+        256,
+    ));
+    for mode in [
+        "on\nlightsamples 4\nlightstratify on",
+        "mis\nimportancesampling brdf",
+        "mis",
+    ] {
+        let other = render(&small_box(&format!("maxdepth 3\nnexteventestimation {mode}"), 64));
+        let g = agreement(&as_rgb(&off), &as_rgb(&other), 8, 6).unwrap();
+        eprintln!("NEE off vs {mode:?}: {g:?}");
+        assert!(
+            g.worst_z.abs() < 5.0 && g.whole_z.abs() < 5.0,
+            "NEE off vs {mode:?}: {g:?}"
+        );
+        assert!((g.mean_ratio - 1.0).abs() < 0.03, "{g:?}");
+    }
+}
+
+fn rmse(a: &Image, b: &Image) -> f64 {
+    let s: f64 = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(x, y)| ((*x - *y) * (*x - *y)).element_sum() as f64)
+        .sum();
+    (s / (3 * a.pixels.len()) as f64).sqrt()
+}
+
+#[test]
+fn the_error_falls_like_one_over_the_root_of_the_samples_and_mis_beats_both_strategies() {
+    // A reference of 8,192 samples per pixel; the errors at 16, 64 and 256 samples. The
+    // reference's own error (√(256/8192) ≈ 18% of the 256-sample error) adds under 2% to
+    // it, so the slope of log error against log spp must be −0.5 within 0.1. (Below 16
+    // samples the error of this 32 × 32 image is ruled by the rare bright samples a
+    // glossy highlight makes, and looks smaller than it is.)
+    let glossy = "maxdepth 1\nimportancesampling brdf";
+    // Another seed: sample i is the same whatever the total, so with the same seed the
+    // renders would be the reference's first samples and their errors would look small.
+    let reference = common::render_job(
+        "r.test",
+        &small_box(&format!("{glossy}\nnexteventestimation mis"), 8192),
+        |job| job.seed = 1,
+    );
+    // Each error is the root of the mean squared error of four renders with other seeds:
+    // one render's error over 1,024 pixels swings with the few bright samples it got.
+    let errors: Vec<f64> = [16, 64, 256]
+        .iter()
+        .map(|&spp| {
+            let text = small_box(&format!("{glossy}\nnexteventestimation mis"), spp);
+            let mse: f64 = (10..14)
+                .map(|seed| rmse(&common::render_job("e.test", &text, |job| job.seed = seed), &reference).powi(2))
+                .sum::<f64>()
+                / 4.0;
+            mse.sqrt()
+        })
+        .collect();
+    let slope = (errors[2] / errors[0]).ln() / 16f64.ln();
+    eprintln!("rmse at 16/64/256 spp: {errors:?}, slope {slope:.3}");
+    assert!((slope + 0.5).abs() < 0.1, "slope {slope}: {errors:?}");
+
+    // Direct light only (maxdepth 1) at 16 samples: light sampling alone (NEE on, one
+    // light sample), BSDF sampling alone (NEE off) and MIS.
+    let light_only = rmse(
+        &render(&small_box(&format!("{glossy}\nnexteventestimation on"), 16)),
+        &reference,
+    );
+    let bsdf_only = rmse(
+        &render(&small_box(&format!("{glossy}\nnexteventestimation off"), 16)),
+        &reference,
+    );
+    let mis = rmse(
+        &render(&small_box(&format!("{glossy}\nnexteventestimation mis"), 16)),
+        &reference,
+    );
+    eprintln!("rmse at 16 spp: light {light_only:.4}, bsdf {bsdf_only:.4}, mis {mis:.4}");
+    assert!(
+        mis < light_only && mis < bsdf_only,
+        "light {light_only}, bsdf {bsdf_only}, mis {mis}"
+    );
+}
+
+#[test]
+fn monte_carlo_renders_are_the_same_bytes_for_any_thread_count() {
+    let text = small_box(
+        "maxdepth -1\nrussianroulette on\nnexteventestimation mis\nimportancesampling brdf",
+        8,
+    );
+    let one = render_scene("t.test", &text, AccelKind::Bvh, 1).0;
+    let two = render_scene("t.test", &text, AccelKind::Bvh, 2).0;
+    let again = render_scene("t.test", &text, AccelKind::Bvh, 2).0;
+    assert_eq!(one.to_rgb_f32(), two.to_rgb_f32());
+    assert_eq!(two.to_rgb_f32(), again.to_rgb_f32());
+}
