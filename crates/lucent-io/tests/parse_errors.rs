@@ -262,11 +262,37 @@ fn unknown_commands_warn_or_fail_in_strict_mode() {
 }
 
 #[test]
-fn unsupported_features_are_errors_not_silent_differences() {
+fn monte_carlo_settings_are_checked_where_they_stand() {
     assert_eq!(
-        first_error("integrator pathtracer"),
-        "t.test:3:12: error: integrator: 'pathtracer' is not implemented yet (this version renders 'raytracer')"
+        first_error("integrator photonmapper"),
+        "t.test:3:12: error: integrator: unknown value 'photonmapper' (expected raytracer, analyticdirect, direct or pathtracer)"
     );
+    assert!(first_error("nexteventestimation maybe").starts_with("t.test:3:21: error: nexteventestimation: "));
+    assert!(first_error("importancesampling light").starts_with("t.test:3:20: error: importancesampling: "));
+    assert!(first_error("roughness -0.1").starts_with("t.test:3:11: error: roughness: "));
+    assert!(first_error("spp 0").starts_with("t.test:3:5: error: spp: must be at least 1"));
+    // A non-square count with stratification: reported at the lightsamples line.
+    let all = messages(
+        &format!("{HEADER}integrator direct\nlightsamples 8\nlightstratify on\n"),
+        false,
+    );
+    assert!(
+        all.iter().any(
+            |m| m.starts_with("t.test:4:14: error: lightsamples: 'lightstratify on' needs a perfect square, got 8")
+        ),
+        "{all:?}"
+    );
+    // Lights an integrator cannot use are named in a warning.
+    let all = messages(
+        &format!("{HEADER}integrator analyticdirect\npoint 0 1 0 1 1 1\n"),
+        false,
+    );
+    assert!(
+        all.iter()
+            .any(|m| m.contains("t.test:4:1: warning: point: integrator analyticdirect renders quad lights only")),
+        "{all:?}"
+    );
+    assert!(first_error("quadLight 0 1 0  1 0 0  2 0 0  1 1 1").contains("quadLight"));
 }
 
 #[test]
