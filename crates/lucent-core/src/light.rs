@@ -125,7 +125,9 @@ impl QuadLight {
         }
     }
 
-    /// Where the ray from `x` along `wi` meets the parallelogram (either side), if it does.
+    /// Where the ray from `x` along `wi` meets the parallelogram (either side), if it does
+    /// (the χ² test's density of a direction; rendering finds lights by tracing).
+    #[cfg(test)]
     pub fn intersect(&self, x: Vec3A, wi: Vec3A) -> Option<f32> {
         let n = self.ab.cross(self.ac);
         let denom = n.dot(wi);
@@ -177,6 +179,16 @@ impl Light {
                     is_delta: true,
                 })
             }
+        }
+    }
+
+    /// The solid-angle density with which [`Light::sample_li`] draws `wi`, which meets
+    /// the light at `distance`: 0 for delta lights, which no found direction is.
+    #[inline]
+    pub fn pdf_li(&self, distance: f32, wi: Vec3A) -> f32 {
+        match self {
+            Light::Quad(q) => q.pdf_li(distance, wi),
+            _ => 0.0,
         }
     }
 

@@ -14,7 +14,7 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use super::{Integrator, PixelSampling, TraceCounts};
+use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
 use crate::hit::BACKGROUND;
 use crate::light::{Light, QuadLight};
 use crate::math::{Color, DVec3, Vec3A};
@@ -42,14 +42,11 @@ pub fn irradiance_vector(q: &QuadLight, x: Vec3A) -> Vec3A {
 
 impl Integrator for AnalyticDirect {
     fn radiance(&self, scene: &Scene, ray: &Ray, _sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
-        counts.rays += 1;
-        let Some(hit) = scene.closest_hit(ray) else {
-            return BACKGROUND;
+        let (hit, sp) = match first_hit(scene, ray, counts) {
+            FirstHit::Nothing => return BACKGROUND,
+            FirstHit::Light(radiance) => return radiance,
+            FirstHit::Surface(hit, sp) => (hit, sp),
         };
-        let sp = scene.surface_point(&hit, ray);
-        if let Some(light) = sp.light {
-            return scene.lights[light as usize].radiance_seen(ray.dir, sp.normal);
-        }
         let m = &scene.materials[sp.material as usize];
         let shaded = surface::shade(m, &scene.textures, &sp, || scene.tangents(&hit, ray));
         let mut total = m.emission;

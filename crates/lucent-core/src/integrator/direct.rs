@@ -12,7 +12,7 @@
 //! light sees its radiance from the front and black from behind.
 
 use super::light_sampling::every_light;
-use super::{Integrator, PixelSampling, TraceCounts};
+use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
 use crate::hit::BACKGROUND;
 use crate::math::Color;
 use crate::ray::Ray;
@@ -28,14 +28,11 @@ pub struct Direct {
 
 impl Integrator for Direct {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
-        counts.rays += 1;
-        let Some(hit) = scene.closest_hit(ray) else {
-            return BACKGROUND;
+        let (hit, sp) = match first_hit(scene, ray, counts) {
+            FirstHit::Nothing => return BACKGROUND,
+            FirstHit::Light(radiance) => return radiance,
+            FirstHit::Surface(hit, sp) => (hit, sp),
         };
-        let sp = scene.surface_point(&hit, ray);
-        if let Some(light) = sp.light {
-            return scene.lights[light as usize].radiance_seen(ray.dir, sp.normal);
-        }
         let bsdf = scene.bsdf(&hit, ray, &sp);
         let emission = scene.materials[sp.material as usize].emission;
         let wo = -ray.dir;

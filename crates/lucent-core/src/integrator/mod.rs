@@ -10,6 +10,7 @@ pub mod light_sampling;
 pub mod path;
 pub mod whitted;
 
+use crate::hit::{Hit, SurfacePoint};
 use crate::math::Color;
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -38,6 +39,28 @@ pub enum PixelSampling {
     /// centre (§4.1's other reading) would weigh the centre 1/spp and add an error that
     /// falls like 1/spp at edges.
     Uniform,
+}
+
+/// What a camera ray meets, for the integrators that look at one surface: nothing, a
+/// light (the radiance it shows the ray: its front's, black from behind) or an ordinary
+/// surface point.
+pub(crate) enum FirstHit {
+    Nothing,
+    Light(Color),
+    Surface(Hit, SurfacePoint),
+}
+
+/// Traces `ray` (counting it) and says what it meets.
+pub(crate) fn first_hit(scene: &Scene, ray: &Ray, counts: &mut TraceCounts) -> FirstHit {
+    counts.rays += 1;
+    let Some(hit) = scene.closest_hit(ray) else {
+        return FirstHit::Nothing;
+    };
+    let sp = scene.surface_point(&hit, ray);
+    match sp.light {
+        Some(light) => FirstHit::Light(scene.lights[light as usize].radiance_seen(ray.dir, sp.normal)),
+        None => FirstHit::Surface(hit, sp),
+    }
 }
 
 pub trait Integrator: Sync {

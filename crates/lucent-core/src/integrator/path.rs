@@ -141,11 +141,8 @@ impl Integrator for PathTracer {
                     (Nee::On, Some(_)) => {} // next-event estimation counted it
                     (Nee::Mis, Some(p_bsdf)) => {
                         if le != Color::ZERO {
-                            let light = &scene.lights[index as usize];
-                            let p_light = match light {
-                                crate::light::Light::Quad(q) => q.pdf_li(hit.t, ray.dir),
-                                _ => 0.0,
-                            } / scene.lights.len() as f32;
+                            let p_light =
+                                scene.lights[index as usize].pdf_li(hit.t, ray.dir) / scene.lights.len() as f32;
                             total += beta * le * power_heuristic(p_bsdf, p_light);
                         }
                     }

@@ -10,7 +10,6 @@ use lucent_core::integrator::direct::Direct;
 use lucent_core::integrator::path::{self, Nee, PathTracer, UNBOUNDED_SAFETY_CAP};
 use lucent_core::integrator::whitted::Whitted;
 use lucent_core::integrator::Integrator;
-use lucent_core::light::Light;
 use lucent_core::math::Color;
 use lucent_core::scene::Scene;
 
@@ -139,13 +138,13 @@ pub const ABSURD_RAYS_PER_PIXEL: f64 = (1u64 << 20) as f64;
 /// setting responsible when it is absurd.
 pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u64, diags: &mut Diagnostics) -> Work {
     let spp = desc.spp() as f64;
-    // (rays per sample, shadow rays per shading point)
-    let (per_sample, shadow) = match chosen {
-        Chosen::Whitted(w) => return estimate_whitted(desc, scene, w, pixels, diags),
-        Chosen::AnalyticDirect(_) => (1.0, 0.0),
+    // (rays per sample, shadow rays per shading point, the deepest bounce)
+    let (per_sample, shadow, depth) = match chosen {
+        Chosen::Whitted(w) => whitted_rays(scene, w),
+        Chosen::AnalyticDirect(_) => (1.0, 0.0, 1),
         Chosen::Direct(d) => {
             let shadow = shadow_rays(scene, d.light_samples);
-            (1.0 + shadow, shadow)
+            (1.0 + shadow, shadow, 1)
         }
         Chosen::PathTracer(p) => {
             // A path's segments (about the depth, or a few with Russian roulette) each
@@ -156,12 +155,9 @@ pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u
                 Nee::On => shadow_rays(scene, p.light_samples),
                 Nee::Mis => 1.0,
             };
-            (segments * (1.0 + shadow), shadow)
+            let depth = p.max_depth.unwrap_or(UNBOUNDED_SAFETY_CAP);
+            (segments * (1.0 + shadow), shadow, depth)
         }
-    };
-    let depth = match chosen {
-        Chosen::PathTracer(p) => p.max_depth.unwrap_or(UNBOUNDED_SAFETY_CAP),
-        _ => 1,
     };
     let work = Work {
         rays_per_pixel: spp * per_sample,
@@ -181,7 +177,9 @@ fn shadow_rays(scene: &Scene, samples: u32) -> f64 {
         .sum()
 }
 
-fn estimate_whitted(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, pixels: u64, diags: &mut Diagnostics) -> Work {
+/// Rays per sample, shadow rays per shading point and the deepest bounce of the
+/// Whitted ray tracer.
+fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, u32) {
     let m = &scene.materials;
     let reflects = m
         .iter()
@@ -194,31 +192,17 @@ fn estimate_whitted(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, pixels: 
     } else {
         0
     };
-    let shadow: f64 = scene
-        .lights
-        .iter()
-        .map(|l| match l {
-            Light::Quad(_) => whitted.light_samples as f64,
-            _ => 1.0,
-        })
-        .sum();
+    let shadow = shadow_rays(scene, whitted.light_samples);
     let glossy = m.iter().filter_map(|m| m.glossy).map(|g| g.samples).max().unwrap_or(1) as f64;
     let split = if m.iter().any(|m| m.transparent != Color::ZERO) {
         2.0
     } else {
         1.0
     };
-    let spp = desc.spp() as f64;
     // Every hit casts its shadow rays; the first bounce fans out into the glossy rays,
     // later ones follow one ray each; glass splits a path in two.
     let per_sample = (1.0 + shadow) * (1.0 + glossy * depth as f64) * split;
-    let work = Work {
-        rays_per_pixel: spp * per_sample,
-        rays: spp * per_sample * pixels as f64,
-        depth,
-    };
-    warn_if_absurd(desc, &work, spp, shadow, depth, diags);
-    work
+    (per_sample, shadow, depth)
 }
 
 fn warn_if_absurd(desc: &SceneDesc, work: &Work, spp: f64, shadow: f64, depth: u32, diags: &mut Diagnostics) {
