@@ -71,6 +71,11 @@ impl Hit {
 #[derive(Clone, Copy, Debug)]
 pub struct SurfacePoint {
     pub point: Vec3A,
+    /// A bound on the rounding error of `point`, per axis (see [`crate::spawn`]).
+    pub error: Vec3A,
+    /// Unit normal of the true surface (the flat triangle, the exact sphere), turned to
+    /// the side the shading normal faces; rays leave along it (see [`crate::spawn`]).
+    pub geometric_normal: Vec3A,
     /// Unit shading normal, as the scene defines it (never flipped toward the viewer).
     pub normal: Vec3A,
     /// Texture coordinates (conventions in [`crate::shape::texcoord`]).

@@ -10,7 +10,7 @@
 //!
 //! | floor | modules |
 //! |---|---|
-//! | 0 base | [`math`], [`transform`], [`ray`], [`aabb`], [`hit`], [`sampler`], [`sampling`] |
+//! | 0 base | [`math`], [`transform`], [`ray`], [`aabb`], [`hit`], [`spawn`], [`sampler`], [`sampling`] |
 //! | 1 shapes | [`shape`]: intersection routines, texture coordinates, tangents |
 //! | 2 acceleration | [`accel`]: structures over any [`accel::PrimitiveSet`] |
 //! | 3 geometry | [`geometry`]: primitives, meshes, instances, the primitive set |
@@ -29,6 +29,7 @@ pub mod math;
 pub mod ray;
 pub mod sampler;
 pub mod sampling;
+pub mod spawn;
 pub mod transform;
 
 pub mod shape;

@@ -19,6 +19,7 @@ const CORE: Floors = &[
     ("ray", 0),
     ("aabb", 0),
     ("hit", 0),
+    ("spawn", 0),
     ("sampler", 0),
     ("sampling", 0),
     ("shape", 1),

@@ -12,6 +12,8 @@ use glam::Vec2;
 #[derive(Clone, Copy, Debug)]
 pub struct Sphere {
     pub world_to_object: Affine3A,
+    /// Carries the hit point, projected onto the unit sphere, back to world space.
+    pub object_to_world: Affine3A,
     /// Inverse transpose of the object-to-world linear part: carries normals to world.
     pub normal_to_world: Mat3A,
     pub bounds: Aabb,
@@ -29,6 +31,7 @@ impl Sphere {
         let c = object_to_world.translation;
         Sphere {
             world_to_object,
+            object_to_world,
             normal_to_world: world_to_object.matrix3.transpose(),
             bounds: Aabb::new(c - half, c + half),
         }

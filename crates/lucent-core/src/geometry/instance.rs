@@ -10,6 +10,7 @@ use crate::aabb::Aabb;
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Affine3A, Mat3A, Vec3A};
 use crate::ray::{PreparedRay, Ray};
+use crate::spawn;
 
 #[derive(Clone)]
 pub struct Instance {
@@ -78,11 +79,15 @@ impl Instance {
         let o = self.world_to_object.transform_point3a(origin);
         let d = self.world_to_object.transform_vector3a(dir);
         let sp = self.object.surface_point(hit, o, d);
+        let (point, error) = spawn::transform_point(&self.object_to_world, sp.point, sp.error);
+        let normal = (self.normal_to_world * sp.normal).normalize();
+        let ng = (self.normal_to_world * sp.geometric_normal).normalize();
         SurfacePoint {
-            // Recomputed in world space rather than transformed back: the same rounding
-            // as every other primitive's hit point.
-            point: origin + dir * hit.t,
-            normal: (self.normal_to_world * sp.normal).normalize(),
+            point,
+            error,
+            // The inverse transpose need not keep the two normals' dot product positive.
+            geometric_normal: if ng.dot(normal) < 0.0 { -ng } else { ng },
+            normal,
             ..sp
         }
     }

@@ -15,6 +15,7 @@ use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Vec3, Vec3A};
 use crate::ray::PreparedRay;
 use crate::shape::triangle;
+use crate::spawn;
 use glam::Vec2;
 
 #[derive(Clone, Debug, Default)]
@@ -141,8 +142,9 @@ impl TriangleMesh {
         crate::shape::tangents::triangle_tangents(p, uv)
     }
 
-    /// Shading data at `hit` (whose `prim` is the triangle) on the ray `origin + t·dir`.
-    pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A) -> SurfacePoint {
+    /// Shading data at `hit` (whose `prim` is the triangle). The point is rebuilt from
+    /// the barycentric weights, not from the ray (see [`crate::spawn`]).
+    pub fn surface_point(&self, hit: &Hit) -> SurfacePoint {
         let k = hit.prim as usize;
         let [i0, i1, i2] = self.indices[k].map(|i| i as usize);
         let b0 = 1.0 - hit.b1 - hit.b2;
@@ -155,17 +157,19 @@ impl TriangleMesh {
             let n = Vec3A::from(n0 * b0 + n1 * hit.b1 + n2 * hit.b2).normalize();
             (n0 != Vec3::ZERO && n1 != Vec3::ZERO && n2 != Vec3::ZERO && n.is_finite()).then_some(n)
         };
-        let normal = smooth.unwrap_or_else(|| {
-            let [a, b, c] = self.corners(hit.prim);
-            triangle::geometric_normal(a, b, c)
-        });
+        let p = self.corners(hit.prim);
+        let ng = triangle::geometric_normal(p[0], p[1], p[2]);
+        let normal = smooth.unwrap_or(ng);
         let uv = if self.uvs.is_empty() {
             Vec2::new(hit.b1, hit.b2)
         } else {
             self.uvs[i0] * b0 + self.uvs[i1] * hit.b1 + self.uvs[i2] * hit.b2
         };
+        let (point, error) = spawn::barycentric_point(p, hit.b1, hit.b2);
         SurfacePoint {
-            point: origin + dir * hit.t,
+            point,
+            error,
+            geometric_normal: if ng.dot(normal) < 0.0 { -ng } else { ng },
             normal,
             uv,
             material: if self.materials.is_empty() {
@@ -278,7 +282,7 @@ mod tests {
             let ray = Ray::new(Vec3A::new(0.25, 0.75, 1.0), -Vec3A::Z);
             let hit = shape.intersect(&PreparedRay::new(ray), f32::INFINITY).unwrap();
             assert_eq!(hit.prim, 1, "{accel:?}");
-            let sp = shape.mesh.surface_point(&hit, ray.origin, ray.dir);
+            let sp = shape.mesh.surface_point(&hit);
             assert!((sp.uv - Vec2::new(0.25, 0.75)).length() < 1e-6, "{}", sp.uv);
             assert_eq!(sp.material, 4);
             assert!((sp.normal - Vec3A::Z).length() < 1e-6);

@@ -10,8 +10,9 @@ use super::mesh::MeshShape;
 use crate::aabb::Aabb;
 use crate::accel::PrimitiveSet;
 use crate::hit::{Hit, SurfacePoint};
-use crate::math::{Affine3A, Vec3A};
+use crate::math::{gamma, Affine3A, Vec3A};
 use crate::ray::PreparedRay;
+use crate::spawn;
 use crate::shape::{sphere, texcoord, triangle};
 use glam::Vec2;
 
@@ -145,37 +146,56 @@ impl Primitive {
     /// Shading data at a hit of `origin + t·dir` on this primitive.
     pub fn surface_point(&self, hit: &Hit, origin: Vec3A, dir: Vec3A, vertex_normals: &[[Vec3A; 3]]) -> SurfacePoint {
         match &self.shape {
-            Shape::Mesh(m) => return m.mesh.surface_point(&hit.inside(), origin, dir),
+            Shape::Mesh(m) => return m.mesh.surface_point(&hit.inside()),
             Shape::Instance(i) => return i.surface_point(&hit.inside(), origin, dir),
             _ => {}
         }
-        let point = origin + dir * hit.t;
         let barycentric = Vec2::new(hit.b1, hit.b2);
-        let (normal, uv) = match &self.shape {
-            Shape::Triangle { p, normals: None } => (triangle::geometric_normal(p[0], p[1], p[2]), barycentric),
-            Shape::Triangle { normals: Some(i), .. } => {
-                let n = &vertex_normals[*i as usize];
-                let b0 = 1.0 - hit.b1 - hit.b2;
-                ((n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize(), barycentric)
+        // (point, its error bound, geometric normal, shading normal, uv)
+        let (point, error, ng, normal, uv) = match &self.shape {
+            Shape::Triangle { p, normals } => {
+                let (point, error) = spawn::barycentric_point(*p, hit.b1, hit.b2);
+                let ng = triangle::geometric_normal(p[0], p[1], p[2]);
+                let normal = match normals {
+                    None => ng,
+                    Some(i) => {
+                        let n = &vertex_normals[*i as usize];
+                        let b0 = 1.0 - hit.b1 - hit.b2;
+                        (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize()
+                    }
+                };
+                (point, error, ng, normal, barycentric)
             }
             Shape::Sphere(s) => {
-                // The object-space hit point is the object-space normal of the unit sphere.
+                // The object-space hit point is the object-space normal of the unit
+                // sphere. Projected back onto the sphere, its error no longer depends on
+                // the error of t (PBR 4th ed. §6.8.5).
                 let o = s.world_to_object.transform_point3a(origin);
                 let d = s.world_to_object.transform_vector3a(dir);
-                let p = o + d * hit.t;
-                ((s.normal_to_world * p).normalize(), texcoord::sphere(p.normalize()))
+                let p = (o + d * hit.t).normalize();
+                let (point, error) = spawn::transform_point(&s.object_to_world, p, p.abs() * gamma(5));
+                let n = (s.normal_to_world * p).normalize();
+                (point, error, n, n, texcoord::sphere(p))
             }
             Shape::Analytic(a) => {
                 let o = a.world_to_object.transform_point3a(origin);
                 let d = a.world_to_object.transform_vector3a(dir);
                 let p = o + d * hit.t;
                 let n = a.kind.normal(p);
-                ((a.normal_to_world * n).normalize(), a.kind.uv(p, n))
+                let normal = (a.normal_to_world * n).normalize();
+                // These shapes find t in f64 and round it once: the point is off by the
+                // rounding of t and of the ray's trip through the transform, a few ulps
+                // of the coordinates involved; 16 of them is a generous bound.
+                let point = origin + dir * hit.t;
+                let error = (origin.abs() + (dir * hit.t).abs()) * gamma(16);
+                (point, error, normal, normal, a.kind.uv(p, n))
             }
             Shape::Mesh(_) | Shape::Instance(_) => unreachable!("handled above"),
         };
         SurfacePoint {
             point,
+            error,
+            geometric_normal: if ng.dot(normal) < 0.0 { -ng } else { ng },
             normal,
             uv,
             material: self.material,
@@ -265,5 +285,84 @@ mod tests {
         let sp = prim.surface_point(&hit, ray.origin, ray.dir, &[]);
         assert!((sp.normal - Vec3A::Z).length() < 1e-5, "{}", sp.normal);
         assert!((sp.uv - glam::Vec2::new(0.75, 0.75)).length() < 1e-5, "{}", sp.uv);
+    }
+
+    /// A small ellipsoid far from the origin, hit from all sides; from each hit point a
+    /// ray leaves almost along the tangent plane, outward. Spawned as `SurfacePoint::spawn`
+    /// does it, none finds the ellipsoid again even with no ε at all; started at the bare
+    /// hit point, many do (so the test can fail).
+    #[test]
+    fn rays_leaving_a_sphere_do_not_find_it_again() {
+        let m = Affine3A::from_translation(glam::Vec3::new(1000.0, -700.0, 300.0))
+            * Affine3A::from_rotation_y(0.3)
+            * Affine3A::from_scale(glam::Vec3::new(3.0, 1.5, 2.0));
+        let prim = Primitive::new(Shape::Sphere(Sphere::new(m)), 0);
+        let centre = Vec3A::new(1000.0, -700.0, 300.0);
+        let mut next = lcg(7);
+        let finds = |origin: Vec3A, dir: Vec3A| {
+            let r = Ray::segment(origin, dir, 0.0, f32::INFINITY);
+            prim.intersect(0, &PreparedRay::new(r), f32::INFINITY).is_some()
+        };
+        let (mut bare, mut spawned, mut tried) = (0, 0, 0);
+        for _ in 0..20_000 {
+            let origin = centre + Vec3A::new(next(), next(), next()).normalize() * 40.0;
+            let dir = (centre + Vec3A::new(next(), next(), next()) * 5.0 - origin).normalize();
+            let ray = Ray::segment(origin, dir, 1e-4, f32::INFINITY);
+            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else { continue };
+            let sp = prim.surface_point(&hit, origin, dir, &[]);
+            let ng = sp.geometric_normal;
+            let tangent = ng.cross(Vec3A::new(next(), next(), next())).normalize();
+            let out = (tangent + ng * 1e-3).normalize();
+            tried += 1;
+            bare += finds(sp.point, out) as u32;
+            spawned += finds(sp.spawn(out).origin, out) as u32;
+        }
+        assert!(tried > 5_000, "{tried}");
+        assert_eq!(spawned, 0, "of {tried}");
+        assert!(bare > 50, "the test must be able to fail: {bare} of {tried}");
+    }
+
+    /// The same for a triangle far from the origin, left at grazing angles on both sides.
+    #[test]
+    fn rays_leaving_a_triangle_do_not_find_it_again() {
+        let p = [
+            Vec3A::new(-2000.0, 500.0, 1000.0),
+            Vec3A::new(-1990.0, 503.0, 1001.0),
+            Vec3A::new(-1996.0, 509.0, 995.0),
+        ];
+        let prim = Primitive::new(Shape::Triangle { p, normals: None }, 0);
+        let centre = (p[0] + p[1] + p[2]) / 3.0;
+        let mut next = lcg(11);
+        let finds = |origin: Vec3A, dir: Vec3A| {
+            let r = Ray::segment(origin, dir, 0.0, f32::INFINITY);
+            prim.intersect(0, &PreparedRay::new(r), f32::INFINITY).is_some()
+        };
+        let (mut bare, mut spawned, mut tried) = (0, 0, 0);
+        for _ in 0..20_000 {
+            let origin = centre + Vec3A::new(next(), next(), next()).normalize() * 30.0;
+            let dir = (centre + Vec3A::new(next(), next(), next()) * 4.0 - origin).normalize();
+            let ray = Ray::segment(origin, dir, 1e-4, f32::INFINITY);
+            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else { continue };
+            let sp = prim.surface_point(&hit, origin, dir, &[]);
+            let ng = sp.geometric_normal;
+            let side = if next() < 0.0 { -ng } else { ng };
+            let tangent = ng.cross(Vec3A::new(next(), next(), next())).normalize();
+            let out = (tangent + side * 1e-4).normalize();
+            tried += 1;
+            bare += finds(sp.point, out) as u32;
+            spawned += finds(sp.spawn(out).origin, out) as u32;
+        }
+        assert!(tried > 5_000, "{tried}");
+        assert_eq!(spawned, 0, "of {tried}");
+        assert!(bare > 50, "the test must be able to fail: {bare} of {tried}");
+    }
+
+    /// Uniform numbers in [−½, ½) from a fixed seed.
+    fn lcg(seed: u64) -> impl FnMut() -> f32 {
+        let mut state = seed;
+        move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        }
     }
 }

@@ -39,7 +39,7 @@ impl Integrator for Direct {
         emission
             + every_light(
                 scene,
-                sp.point,
+                &sp,
                 wo,
                 &bsdf,
                 self.light_samples,

@@ -7,7 +7,7 @@
 use super::TraceCounts;
 use crate::light::LightSample;
 use crate::math::{Color, Vec3A};
-use crate::ray::{Ray, EPSILON};
+use crate::hit::SurfacePoint;
 use crate::sampler::{stratified, Sampler};
 use crate::sampling::mis::power_heuristic;
 use crate::scene::Scene;
@@ -16,18 +16,18 @@ use crate::shading::bsdf::Bsdf;
 /// Whether nothing blocks the segment from `x` to the light sample (a shadow ray that
 /// stops ε short of the sampled point).
 #[inline]
-pub fn unoccluded(scene: &Scene, x: Vec3A, s: &LightSample, counts: &mut TraceCounts) -> bool {
+pub fn unoccluded(scene: &Scene, x: &SurfacePoint, s: &LightSample, counts: &mut TraceCounts) -> bool {
     counts.rays += 1;
-    let shadow = Ray::segment(x, s.wi, EPSILON, s.distance - EPSILON);
-    !scene.occluded(&shadow)
+    !scene.occluded(&x.spawn_segment(s.wi, s.distance))
 }
 
 /// `f · max(n·wi, 0) · Li / pdf` of one light sample, before visibility; zero when the
-/// light is behind the surface or the BSDF sends nothing that way.
+/// light is behind the surface (by the shading normal or the true surface) or the BSDF
+/// sends nothing that way.
 #[inline]
-fn unshadowed(bsdf: &Bsdf, wo: Vec3A, s: &LightSample) -> Color {
+fn unshadowed(x: &SurfacePoint, bsdf: &Bsdf, wo: Vec3A, s: &LightSample) -> Color {
     let cos = bsdf.normal().dot(s.wi);
-    if !(cos > 0.0) {
+    if !(cos > 0.0) || !x.above_geometry(s.wi) {
         return Color::ZERO;
     }
     bsdf.eval(wo, s.wi) * s.radiance * (cos / s.pdf)
@@ -38,7 +38,7 @@ fn unshadowed(bsdf: &Bsdf, wo: Vec3A, s: &LightSample) -> Color {
 /// light.
 pub fn every_light(
     scene: &Scene,
-    x: Vec3A,
+    x: &SurfacePoint,
     wo: Vec3A,
     bsdf: &Bsdf,
     samples: u32,
@@ -53,8 +53,8 @@ pub fn every_light(
         for k in 0..n {
             let (u, v) = sampler.uniform2();
             let (u, v) = if stratify { stratified(k, n, u, v) } else { (u, v) };
-            let Some(s) = light.sample_li(x, u, v) else { continue };
-            let c = unshadowed(bsdf, wo, &s);
+            let Some(s) = light.sample_li(x.point, u, v) else { continue };
+            let c = unshadowed(x, bsdf, wo, &s);
             if c != Color::ZERO && unoccluded(scene, x, &s, counts) {
                 sum += c;
             }
@@ -68,7 +68,7 @@ pub fn every_light(
 /// strategy whose density for a direction is `bsdf_pdf`.
 pub fn one_light_mis(
     scene: &Scene,
-    x: Vec3A,
+    x: &SurfacePoint,
     wo: Vec3A,
     bsdf: &Bsdf,
     bsdf_pdf: impl Fn(Vec3A) -> f32,
@@ -82,7 +82,7 @@ pub fn one_light_mis(
         return Color::ZERO;
     }
     let light = &scene.lights[((pick * count as f32) as usize).min(count - 1)];
-    let Some(mut s) = light.sample_li(x, u, v) else {
+    let Some(mut s) = light.sample_li(x.point, u, v) else {
         return Color::ZERO;
     };
     // The density of choosing this light and this point on it.
@@ -92,7 +92,7 @@ pub fn one_light_mis(
     } else {
         power_heuristic(s.pdf, bsdf_pdf(s.wi))
     };
-    let c = unshadowed(bsdf, wo, &s);
+    let c = unshadowed(x, bsdf, wo, &s);
     if c == Color::ZERO || !unoccluded(scene, x, &s, counts) {
         return Color::ZERO;
     }

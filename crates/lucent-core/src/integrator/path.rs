@@ -23,6 +23,7 @@
 
 use super::light_sampling::{every_light, one_light_mis};
 use super::{Integrator, PixelSampling, TraceCounts};
+use crate::hit::SurfacePoint;
 use crate::math::{Color, Vec3A};
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -85,8 +86,8 @@ impl PathTracer {
     }
 
     /// The next direction, or `None` when the path ends (nothing drawn, or a direction
-    /// below the surface).
-    fn bounce(&self, bsdf: &Bsdf, wo: Vec3A, sampler: &mut Sampler) -> Option<Bounce> {
+    /// below the surface: by the shading normal or by the true surface at `x`).
+    fn bounce(&self, x: &SurfacePoint, bsdf: &Bsdf, wo: Vec3A, sampler: &mut Sampler) -> Option<Bounce> {
         let n = bsdf.normal();
         let pick = sampler.uniform();
         let (u, v) = sampler.uniform2();
@@ -105,7 +106,7 @@ impl PathTracer {
             }
         };
         let cos = n.dot(wi);
-        (cos > 0.0 && pdf > 0.0).then_some(Bounce { wi, f, cos, pdf })
+        (cos > 0.0 && pdf > 0.0 && x.above_geometry(wi)).then_some(Bounce { wi, f, cos, pdf })
     }
 
     /// Whether scattering event `k` (at x_k) may happen.
@@ -167,7 +168,7 @@ impl Integrator for PathTracer {
                     total += beta
                         * every_light(
                             scene,
-                            sp.point,
+                            &sp,
                             wo,
                             &bsdf,
                             self.light_samples,
@@ -178,7 +179,7 @@ impl Integrator for PathTracer {
                 }
                 Nee::Mis => {
                     let pdf = |wi| self.direction_pdf(&bsdf, wo, wi);
-                    total += beta * one_light_mis(scene, sp.point, wo, &bsdf, pdf, sampler, counts);
+                    total += beta * one_light_mis(scene, &sp, wo, &bsdf, pdf, sampler, counts);
                 }
             }
             // With NEE the last scattering event's light is already counted; MIS still
@@ -187,7 +188,7 @@ impl Integrator for PathTracer {
             if last && self.nee == Nee::On {
                 break;
             }
-            let Some(b) = self.bounce(&bsdf, wo, sampler) else {
+            let Some(b) = self.bounce(&sp, &bsdf, wo, sampler) else {
                 break;
             };
             beta *= b.f * (b.cos / b.pdf);
@@ -202,7 +203,7 @@ impl Integrator for PathTracer {
             if !beta.is_finite() || beta == Color::ZERO {
                 break;
             }
-            ray = Ray::new(sp.point, b.wi);
+            ray = sp.spawn(b.wi);
             bsdf_pdf = Some(b.pdf);
             k += 1;
         }

@@ -26,6 +26,11 @@
 //!   grow geometrically), each weighted `S / samples`; rays that would leave below the
 //!   surface count as black.
 //!
+//! Secondary rays leave the hit point offset past its rounding error (`crate::spawn`).
+//! Where an interpolated or bumped normal would mirror a ray into the true surface (or
+//! refract it out on the viewer's side), the ray is turned back to just past the surface
+//! (`lift_above`); glossy rays below the true surface count as black.
+//!
 //! The ray tree is walked with an explicit stack, in the order of the recursion it
 //! stands for, so that no scene can overflow the thread's stack; a branch whose weight
 //! can no longer show is not traced (adaptive depth control, [`super::depth`]).
@@ -35,10 +40,10 @@ use super::{Integrator, TraceCounts};
 use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::light::Light;
 use crate::math::{Color, Vec3A};
-use crate::ray::{Ray, EPSILON};
+use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
-use crate::shading::optics::{fresnel_dielectric, phong_lobe, reflect, refract};
+use crate::shading::optics::{fresnel_dielectric, lift_above, phong_lobe, reflect, refract};
 use crate::shading::surface;
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
@@ -67,10 +72,10 @@ pub const MAX_PENDING: usize = 1 << 16;
 enum Branch {
     /// A ray (and the mirror chain after it, followed in a loop).
     Ray { ray: Ray, depth: u32, weight: Color },
-    /// Glossy rays still to draw, `left` of them, around the mirror direction `mirror`
-    /// at `point`, each of weight `weight`, on the side `side` of the surface.
+    /// Glossy rays still to draw, `left` of them, around the mirror direction `mirror`,
+    /// leaving `from`, each of weight `weight`, on the side `side` of the true surface.
     Glossy {
-        point: Vec3A,
+        from: SurfacePoint,
         mirror: Vec3A,
         side: Vec3A,
         exponent: f32,
@@ -128,7 +133,7 @@ impl Whitted {
                     }
                     t.counts.rays += 1;
                     // Aimed at a point on the light: stops just before it.
-                    let shadow = Ray::segment(sp.point, inc.dir, EPSILON, inc.distance - EPSILON);
+                    let shadow = sp.spawn_segment(inc.dir, inc.distance);
                     if !scene.occluded(&shadow) {
                         sum += inc.intensity * reflected;
                     }
@@ -145,7 +150,7 @@ impl Whitted {
                 continue;
             }
             t.counts.rays += 1;
-            let shadow = Ray::segment(sp.point, inc.dir, EPSILON, inc.distance - EPSILON);
+            let shadow = sp.spawn_segment(inc.dir, inc.distance);
             if !scene.occluded(&shadow) {
                 color += inc.intensity * reflected;
             }
@@ -185,6 +190,10 @@ impl Whitted {
             }
             let m = &scene.materials[sp.material as usize];
             let (d, n) = (ray.dir, sp.normal);
+            // The side of the true surface the ray came from: reflected rays must leave
+            // on it and refracted rays on the other, whatever the shading normal says.
+            let ng = sp.geometric_normal;
+            let (viewer, viewer_cos) = if d.dot(ng) <= 0.0 { (ng, -d.dot(ng)) } else { (-ng, d.dot(ng)) };
             let mut mirror = m.specular;
             let mut refracted = None;
             if m.transparent != Color::ZERO {
@@ -195,8 +204,9 @@ impl Whitted {
                 let through = weight * m.transparent * (1.0 - f);
                 if f < 1.0 && through.max_element() > MIN_WEIGHT {
                     if let Some(dir) = refract(d, facing, n_i / n_t) {
+                        let dir = if dir.dot(viewer) < 0.0 { dir } else { lift_above(dir, -viewer, 0.01) };
                         refracted = Some(Branch::Ray {
-                            ray: Ray::new(sp.point, dir),
+                            ray: sp.spawn(dir),
                             depth: depth + 1,
                             weight: through,
                         });
@@ -211,15 +221,14 @@ impl Whitted {
             let reflected = if mirror == Color::ZERO || negligible {
                 None
             } else {
-                let r = reflect(d, n).normalize();
+                let r = lift_above(reflect(d, n).normalize(), viewer, (0.9 * viewer_cos).min(0.01));
                 Some(match m.glossy {
                     Some(g) => {
                         let count = if depth == 0 { g.samples.max(1) } else { 1 };
                         Branch::Glossy {
-                            point: sp.point,
+                            from: sp,
                             mirror: r,
-                            // Rays leave on the side the reflected ray is on.
-                            side: if r.dot(n) >= 0.0 { n } else { -n },
+                            side: viewer,
                             exponent: g.exponent,
                             left: count,
                             depth: depth + 1,
@@ -227,7 +236,7 @@ impl Whitted {
                         }
                     }
                     None => Branch::Ray {
-                        ray: Ray::new(sp.point, r),
+                        ray: sp.spawn(r),
                         depth: depth + 1,
                         weight: weight * mirror,
                     },
@@ -275,7 +284,7 @@ impl Whitted {
     /// stack, above the rays still to draw, so that it is traced before they are drawn.
     fn next_glossy(&self, t: &mut Tracing, glossy: Branch, pending: &mut Vec<Branch>) {
         let Branch::Glossy {
-            point,
+            from,
             mirror,
             side,
             exponent,
@@ -290,7 +299,7 @@ impl Whitted {
         let dir = phong_lobe(mirror, exponent, u, v);
         if left > 1 {
             let rest = Branch::Glossy {
-                point,
+                from,
                 mirror,
                 side,
                 exponent,
@@ -302,7 +311,7 @@ impl Whitted {
         }
         if dir.dot(side) > 0.0 {
             let ray = Branch::Ray {
-                ray: Ray::new(point, dir),
+                ray: from.spawn(dir),
                 depth,
                 weight,
             };

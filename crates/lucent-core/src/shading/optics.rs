@@ -38,6 +38,26 @@ pub fn fresnel_dielectric(cos_i: f32, n_i: f32, n_t: f32) -> f32 {
     0.5 * (r_s * r_s + r_p * r_p)
 }
 
+/// `w` (unit) if it leaves at least `height` (a cosine) above the surface whose unit
+/// normal on the wanted side is `side`; otherwise `w` turned toward `side`, in the plane
+/// of the two, until it leaves at exactly `height`. A smooth-shaded or bump-mapped normal
+/// can mirror or refract a ray into the true surface it leaves; turning it back just
+/// past the surface keeps the ray's direction as close as possible (the remedy of
+/// Cycles' `ensure_valid_reflection`) instead of sending it into the object.
+#[inline]
+pub fn lift_above(w: Vec3A, side: Vec3A, height: f32) -> Vec3A {
+    let c = w.dot(side);
+    if c >= height {
+        return w;
+    }
+    let along = w - side * c;
+    let len = along.length();
+    if !(len > 0.0) {
+        return side;
+    }
+    (along * ((1.0 - height * height).max(0.0).sqrt() / len) + side * height).normalize()
+}
+
 /// A direction drawn around the unit axis `r` with density ∝ `cos^exponent` of the angle
 /// to it (the Phong lobe), from two uniform numbers.
 pub fn phong_lobe(r: Vec3A, exponent: f32, u: f32, v: f32) -> Vec3A {
@@ -56,6 +76,21 @@ pub fn phong_lobe(r: Vec3A, exponent: f32, u: f32, v: f32) -> Vec3A {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lifted_directions_keep_their_azimuth_and_leave_at_the_height_asked() {
+        let side = Vec3A::new(0.0, 0.0, 1.0);
+        // Already high enough: unchanged.
+        let w = Vec3A::new(0.6, 0.0, 0.8);
+        assert_eq!(lift_above(w, side, 0.01), w);
+        // Below the surface: turned up to height 0.01, same azimuth.
+        let w = Vec3A::new(0.6, 0.48, -0.64).normalize();
+        let l = lift_above(w, side, 0.01);
+        assert!((l.length() - 1.0).abs() < 1e-6 && (l.z - 0.01).abs() < 1e-6, "{l}");
+        assert!((l.y / l.x - 0.8).abs() < 1e-5, "{l}");
+        // Straight down: nothing to keep, straight up.
+        assert_eq!(lift_above(-side, side, 0.01), side);
+    }
 
     #[test]
     fn fresnel_at_normal_incidence_on_glass_is_four_percent() {

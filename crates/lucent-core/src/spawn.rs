@@ -1,0 +1,153 @@
+//! Rays that leave a surface, without finding it again by mistake.
+//!
+//! A hit point is computed in `f32`, so it lies a little off the true surface, on either
+//! side. A ray leaving it that starts on the wrong side meets the surface it leaves: the
+//! dark dots and notches of "shadow acne", strongest where rays leave at a grazing angle
+//! (a sphere near its silhouette, a reflection off a smooth-shaded mesh). The course's
+//! remedy — skip hits closer than ε — fails exactly there, because a grazing ray can stay
+//! inside a rounding-sized sliver for much longer than ε.
+//!
+//! pbrt-v4's remedy (Pharr, Jakob & Humphreys, *Physically Based Rendering*, 4th ed.,
+//! §6.8) is used here: every shape reports with its hit point a conservative bound on
+//! the point's rounding error per axis, computed so that it does not depend on the error
+//! of `t` (triangles rebuild the point from its barycentric weights, spheres project it
+//! back onto the sphere). A spawned ray starts at the point moved along the geometric
+//! normal, past that bound, to the side its direction leaves by; the true surface is then
+//! certainly behind it. The ray keeps the format's `t > ε` (SCENE_FORMAT.md §4.2) on top,
+//! so the course images keep their meaning.
+
+use crate::hit::SurfacePoint;
+use crate::math::{gamma, Affine3A, Vec3A};
+use crate::ray::{Ray, EPSILON};
+
+/// The smallest `f32` above `x` (`x` itself for +∞ and NaN).
+#[inline]
+pub fn next_up(x: f32) -> f32 {
+    if x.is_nan() || x == f32::INFINITY {
+        return x;
+    }
+    if x == 0.0 {
+        return f32::from_bits(1); // the smallest positive subnormal, for +0 and −0
+    }
+    let bits = x.to_bits();
+    f32::from_bits(if x > 0.0 { bits + 1 } else { bits - 1 })
+}
+
+/// The largest `f32` below `x`.
+#[inline]
+pub fn next_down(x: f32) -> f32 {
+    -next_up(-x)
+}
+
+/// `p0·b0 + p1·b1 + p2·b2` with `b0 = 1 − b1 − b2`, and the bound on its rounding error.
+/// Any weights that sum to one give a point of the triangle's plane, so the point's
+/// distance from the plane is rounding alone, whatever the error of the weights.
+#[inline]
+pub fn barycentric_point(p: [Vec3A; 3], b1: f32, b2: f32) -> (Vec3A, Vec3A) {
+    let b0 = 1.0 - b1 - b2;
+    let (a, b, c) = (p[0] * b0, p[1] * b1, p[2] * b2);
+    let point = a + b + c;
+    // γ7 covers the products and sums (PBR 4th ed. §6.8.5); one more for b0's rounding.
+    let error = (a.abs() + b.abs() + c.abs()) * gamma(8);
+    (point, error)
+}
+
+/// `m · p` and the bound on its error, given the bound `error` on `p`'s (PBR 4th ed.
+/// §6.8.6, transforming points with error).
+#[inline]
+pub fn transform_point(m: &Affine3A, p: Vec3A, error: Vec3A) -> (Vec3A, Vec3A) {
+    let point = m.transform_point3a(p);
+    let abs = |v: Vec3A| v.abs();
+    let (cx, cy, cz) = (abs(m.matrix3.x_axis), abs(m.matrix3.y_axis), abs(m.matrix3.z_axis));
+    // The rounding of this product, then the incoming error carried through it.
+    let own = (cx * p.x.abs() + cy * p.y.abs() + cz * p.z.abs() + m.translation.abs()) * gamma(3);
+    let carried = (cx * error.x + cy * error.y + cz * error.z) * (1.0 + gamma(3));
+    (point, own + carried)
+}
+
+/// The origin of a ray leaving `point` (rounding error at most `error` per axis) toward
+/// `dir`, on a surface with geometric normal `ng`: moved along `ng` past the error bound
+/// to the side `dir` leaves by, and rounded away from the surface.
+#[inline]
+pub fn offset_origin(point: Vec3A, error: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A {
+    let distance = ng.abs().dot(error);
+    let mut offset = ng * distance;
+    if dir.dot(ng) < 0.0 {
+        offset = -offset;
+    }
+    let moved = point + offset;
+    // Rounding the sum could bring it back toward the surface: step one ulp further.
+    let away = |m: f32, o: f32| {
+        if o > 0.0 {
+            next_up(m)
+        } else if o < 0.0 {
+            next_down(m)
+        } else {
+            m
+        }
+    };
+    Vec3A::new(away(moved.x, offset.x), away(moved.y, offset.y), away(moved.z, offset.z))
+}
+
+impl SurfacePoint {
+    /// A ray leaving this point in direction `dir` (unit length), that cannot find this
+    /// surface again by rounding error.
+    #[inline]
+    pub fn spawn(&self, dir: Vec3A) -> Ray {
+        Ray::new(offset_origin(self.point, self.error, self.geometric_normal, dir), dir)
+    }
+
+    /// A shadow ray toward a point `distance` away in direction `dir`: it stops ε short.
+    #[inline]
+    pub fn spawn_segment(&self, dir: Vec3A, distance: f32) -> Ray {
+        let origin = offset_origin(self.point, self.error, self.geometric_normal, dir);
+        Ray::segment(origin, dir, EPSILON, distance - EPSILON)
+    }
+
+    /// Whether direction `w` leaves on the side of the geometric surface that the
+    /// shading normal faces. A smooth-shaded or bump-mapped surface can put directions
+    /// above the shading normal's horizon that go into the true (flat) surface; every
+    /// integrator gives those no light, so that no ray is sent into the object it leaves.
+    #[inline]
+    pub fn above_geometry(&self, w: Vec3A) -> bool {
+        w.dot(self.geometric_normal) > 0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn next_up_and_down_step_one_ulp() {
+        assert_eq!(next_up(1.0), 1.0 + f32::EPSILON);
+        assert_eq!(next_down(1.0), 1.0 - f32::EPSILON / 2.0);
+        assert!(next_up(0.0) > 0.0 && next_down(0.0) < 0.0);
+        assert_eq!(next_up(-1.0), -(1.0 - f32::EPSILON / 2.0));
+        assert_eq!(next_up(f32::INFINITY), f32::INFINITY);
+    }
+
+    #[test]
+    fn barycentric_points_lie_on_the_plane_within_their_bound() {
+        let p = [
+            Vec3A::new(1e3, 2e3, -5e2),
+            Vec3A::new(1e3 + 1.0, 2e3 + 0.3, -5e2 + 0.1),
+            Vec3A::new(1e3 - 0.2, 2e3 + 0.9, -5e2 + 0.7),
+        ];
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        let mut state = 3u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..10_000 {
+            let (b1, b2) = (next() * 0.5, next() * 0.5);
+            let (q, e) = barycentric_point(p, b1, b2);
+            // Distance from the plane, in f64 from the exact vertices.
+            let dq = q.as_dvec3() - p[0].as_dvec3();
+            let dn = n.as_dvec3();
+            let along = dq.dot(dn).abs();
+            assert!(along <= n.abs().dot(e) as f64 * 1.01 + 1e-9, "{along} > {}", n.abs().dot(e));
+        }
+    }
+}
