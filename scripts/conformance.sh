@@ -3,7 +3,7 @@
 # reference images (../shared/corpus/README.md says which are official).
 #
 #   scene4-*, scene5, scene6, scene7 (PNG references): at most 300 of 307,200 pixels may
-#     differ by more than 2/255 in any channel, and the mean absolute error must be < 0.05.
+#     differ by more than 2/255 in any channel (scene5: 10), and the mean absolute error must be < 0.05.
 #   scene1-*, scene2-*, scene3 (lossy JPEG references): mean absolute error < 2.
 #   The images are also byte-identical with 1 and 2 threads and with every --accel structure.
 #
@@ -54,7 +54,10 @@ same_bytes() { # name, lucent render options...
 
 echo "conformance: course scenes from $scenes"
 for s in scene4-ambient scene4-diffuse scene4-emission scene4-specular scene5 scene6 scene7; do
-    check "$s" --max-pixels 300 --max-mae 0.05
+    # scene5 is held to what lucent reaches since rays leave surfaces past their rounding
+    # error (1 pixel; the best independent implementation has 10).
+    limit=300; [ "$s" = scene5 ] && limit=10
+    check "$s" --max-pixels "$limit" --max-mae 0.05
 done
 for s in scene1-camera1 scene1-camera2 scene1-camera3 scene1-camera4 scene2-camera1 scene2-camera2 scene2-camera3 scene3; do
     check "$s" --max-mae 2
@@ -73,7 +76,8 @@ done
 mc=$corpus/cse168
 if [ -d "$mc" ]; then
     echo "conformance: CSE168 scenes from $mc"
-    # analyticdirect is deterministic: compared pixel by pixel (off by at most one step).
+    # analyticdirect is deterministic: compared pixel by pixel. 10 pixels are one step off (an
+    # independent reimplementation of the formula gets 12: SCENE_FORMAT.md, REF-IMG); at most 20 may be.
     "$bin" render "$mc/ref/hw2/analytic.test" -o "$out/analytic.png" --quiet
     if result=$("$bin" diff "$out/analytic.png" "$mc/ref/hw2/analytic.png" --threshold 0 --max-pixels 20); then
         printf '%-16s ok    %s\n' analytic "$result"; passed=$((passed + 1))
