@@ -233,6 +233,7 @@ impl PrimitiveSet for [Primitive] {
 mod tests {
     use super::super::analytic::AnalyticKind;
     use super::*;
+    use crate::geometry::test_scenes::Rng;
     use crate::ray::Ray;
 
     #[test]
@@ -298,7 +299,8 @@ mod tests {
             * Affine3A::from_scale(glam::Vec3::new(3.0, 1.5, 2.0));
         let prim = Primitive::new(Shape::Sphere(Sphere::new(m)), 0);
         let centre = Vec3A::new(1000.0, -700.0, 300.0);
-        let mut next = lcg(7);
+        let mut rng = Rng(7);
+        let mut next = || rng.range(-0.5, 0.5);
         let finds = |origin: Vec3A, dir: Vec3A| {
             let r = Ray::segment(origin, dir, 0.0, f32::INFINITY);
             prim.intersect(0, &PreparedRay::new(r), f32::INFINITY).is_some()
@@ -332,7 +334,8 @@ mod tests {
         ];
         let prim = Primitive::new(Shape::Triangle { p, normals: None }, 0);
         let centre = (p[0] + p[1] + p[2]) / 3.0;
-        let mut next = lcg(11);
+        let mut rng = Rng(11);
+        let mut next = || rng.range(-0.5, 0.5);
         let finds = |origin: Vec3A, dir: Vec3A| {
             let r = Ray::segment(origin, dir, 0.0, f32::INFINITY);
             prim.intersect(0, &PreparedRay::new(r), f32::INFINITY).is_some()
@@ -357,12 +360,24 @@ mod tests {
         assert!(bare > 50, "the test must be able to fail: {bare} of {tried}");
     }
 
-    /// Uniform numbers in [−½, ½) from a fixed seed.
-    fn lcg(seed: u64) -> impl FnMut() -> f32 {
-        let mut state = seed;
-        move || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+    #[test]
+    fn barycentric_points_lie_on_the_plane_within_their_bound() {
+        let p = [
+            Vec3A::new(1e3, 2e3, -5e2),
+            Vec3A::new(1e3 + 1.0, 2e3 + 0.3, -5e2 + 0.1),
+            Vec3A::new(1e3 - 0.2, 2e3 + 0.9, -5e2 + 0.7),
+        ];
+        let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        let mut rng = Rng(3);
+        let mut next = || rng.next();
+        for _ in 0..10_000 {
+            let (b1, b2) = (next() * 0.5, next() * 0.5);
+            let (q, e) = spawn::barycentric_point(p, b1, b2);
+            // Distance from the plane, in f64 from the exact vertices.
+            let dq = q.as_dvec3() - p[0].as_dvec3();
+            let dn = n.as_dvec3();
+            let along = dq.dot(dn).abs();
+            assert!(along <= n.abs().dot(e) as f64 * 1.01 + 1e-9, "{along} > {}", n.abs().dot(e));
         }
     }
 }
