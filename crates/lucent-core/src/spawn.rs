@@ -86,7 +86,11 @@ pub fn offset_origin(point: Vec3A, error: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A
             m
         }
     };
-    Vec3A::new(away(moved.x, offset.x), away(moved.y, offset.y), away(moved.z, offset.z))
+    Vec3A::new(
+        away(moved.x, offset.x),
+        away(moved.y, offset.y),
+        away(moved.z, offset.z),
+    )
 }
 
 impl SurfacePoint {

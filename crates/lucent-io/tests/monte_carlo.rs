@@ -249,7 +249,6 @@ fn the_error_falls_like_one_over_the_root_of_the_samples() {
     let slope = (errors[2] / errors[0]).ln() / 16f64.ln();
     eprintln!("rmse at 16/64/256 spp: {errors:?}, slope {slope:.3}");
     assert!((slope + 0.5).abs() < 0.1, "slope {slope}: {errors:?}");
-
 }
 
 /// Veach's test of multiple importance sampling (the scene of the course's `mis.test`):
@@ -272,11 +271,23 @@ fn glossy_plates(settings: &str, half_size: f64, spp: u32) -> String {
     }
     for (k, (_, shininess)) in plates.iter().enumerate() {
         let v = 4 * k;
-        s += &format!("shininess {shininess}\ntri {v} {} {}\ntri {v} {} {}\n", v + 1, v + 2, v + 2, v + 3);
+        s += &format!(
+            "shininess {shininess}\ntri {v} {} {}\ntri {v} {} {}\n",
+            v + 1,
+            v + 2,
+            v + 2,
+            v + 3
+        );
     }
     // The same power whatever the size; it faces −z (ac × ab).
     let (h, le) = (half_size, 2.0 / (4.0 * half_size * half_size));
-    s += &format!("quadLight {} {} 10  {} 0 0  0 {} 0  {le} {le} {le}\n", 3.0 - h, -h, 2.0 * h, 2.0 * h);
+    s += &format!(
+        "quadLight {} {} 10  {} 0 0  0 {} 0  {le} {le} {le}\n",
+        3.0 - h,
+        -h,
+        2.0 * h,
+        2.0 * h
+    );
     s
 }
 

@@ -12,8 +12,8 @@ use crate::accel::PrimitiveSet;
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::{gamma, Affine3A, Vec3A};
 use crate::ray::PreparedRay;
-use crate::spawn;
 use crate::shape::{sphere, texcoord, triangle};
+use crate::spawn;
 use glam::Vec2;
 
 #[derive(Clone, Debug)]
@@ -310,7 +310,9 @@ mod tests {
             let origin = centre + Vec3A::new(next(), next(), next()).normalize() * 40.0;
             let dir = (centre + Vec3A::new(next(), next(), next()) * 5.0 - origin).normalize();
             let ray = Ray::segment(origin, dir, 1e-4, f32::INFINITY);
-            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else { continue };
+            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else {
+                continue;
+            };
             let sp = prim.surface_point(&hit, origin, dir, &[]);
             let ng = sp.geometric_normal;
             let tangent = ng.cross(Vec3A::new(next(), next(), next())).normalize();
@@ -345,7 +347,9 @@ mod tests {
             let origin = centre + Vec3A::new(next(), next(), next()).normalize() * 30.0;
             let dir = (centre + Vec3A::new(next(), next(), next()) * 4.0 - origin).normalize();
             let ray = Ray::segment(origin, dir, 1e-4, f32::INFINITY);
-            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else { continue };
+            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else {
+                continue;
+            };
             let sp = prim.surface_point(&hit, origin, dir, &[]);
             let ng = sp.geometric_normal;
             let side = if next() < 0.0 { -ng } else { ng };
@@ -377,7 +381,11 @@ mod tests {
             let dq = q.as_dvec3() - p[0].as_dvec3();
             let dn = n.as_dvec3();
             let along = dq.dot(dn).abs();
-            assert!(along <= n.abs().dot(e) as f64 * 1.01 + 1e-9, "{along} > {}", n.abs().dot(e));
+            assert!(
+                along <= n.abs().dot(e) as f64 * 1.01 + 1e-9,
+                "{along} > {}",
+                n.abs().dot(e)
+            );
         }
     }
 }

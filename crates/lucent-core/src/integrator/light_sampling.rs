@@ -5,9 +5,9 @@
 //! heuristic against the BSDF strategy's density).
 
 use super::TraceCounts;
+use crate::hit::SurfacePoint;
 use crate::light::LightSample;
 use crate::math::{Color, Vec3A};
-use crate::hit::SurfacePoint;
 use crate::sampler::{stratified, Sampler};
 use crate::sampling::mis::power_heuristic;
 use crate::scene::Scene;
@@ -53,7 +53,9 @@ pub fn every_light(
         for k in 0..n {
             let (u, v) = sampler.uniform2();
             let (u, v) = if stratify { stratified(k, n, u, v) } else { (u, v) };
-            let Some(s) = light.sample_li(x.point, u, v) else { continue };
+            let Some(s) = light.sample_li(x.point, u, v) else {
+                continue;
+            };
             let c = unshadowed(x, bsdf, wo, &s);
             if c != Color::ZERO && unoccluded(scene, x, &s, counts) {
                 sum += c;

@@ -193,7 +193,11 @@ impl Whitted {
             // The side of the true surface the ray came from: reflected rays must leave
             // on it and refracted rays on the other, whatever the shading normal says.
             let ng = sp.geometric_normal;
-            let (viewer, viewer_cos) = if d.dot(ng) <= 0.0 { (ng, -d.dot(ng)) } else { (-ng, d.dot(ng)) };
+            let (viewer, viewer_cos) = if d.dot(ng) <= 0.0 {
+                (ng, -d.dot(ng))
+            } else {
+                (-ng, d.dot(ng))
+            };
             let mut mirror = m.specular;
             let mut refracted = None;
             if m.transparent != Color::ZERO {
@@ -204,7 +208,11 @@ impl Whitted {
                 let through = weight * m.transparent * (1.0 - f);
                 if f < 1.0 && through.max_element() > MIN_WEIGHT {
                     if let Some(dir) = refract(d, facing, n_i / n_t) {
-                        let dir = if dir.dot(viewer) < 0.0 { dir } else { lift_above(dir, -viewer, 0.01) };
+                        let dir = if dir.dot(viewer) < 0.0 {
+                            dir
+                        } else {
+                            lift_above(dir, -viewer, 0.01)
+                        };
                         refracted = Some(Branch::Ray {
                             ray: sp.spawn(dir),
                             depth: depth + 1,
