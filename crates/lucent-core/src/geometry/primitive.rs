@@ -288,39 +288,55 @@ mod tests {
         assert!((sp.uv - glam::Vec2::new(0.75, 0.75)).length() < 1e-5, "{}", sp.uv);
     }
 
-    /// A small ellipsoid far from the origin, hit from all sides; from each hit point a
-    /// ray leaves almost along the tangent plane, outward. Spawned as `SurfacePoint::spawn`
-    /// does it, none finds the ellipsoid again even with no ε at all; started at the bare
-    /// hit point, many do (so the test can fail).
-    #[test]
-    fn rays_leaving_a_sphere_do_not_find_it_again() {
-        let m = Affine3A::from_translation(glam::Vec3::new(1000.0, -700.0, 300.0))
-            * Affine3A::from_rotation_y(0.3)
-            * Affine3A::from_scale(glam::Vec3::new(3.0, 1.5, 2.0));
-        let prim = Primitive::new(Shape::Sphere(Sphere::new(m)), 0);
-        let centre = Vec3A::new(1000.0, -700.0, 300.0);
+    /// Aims 20,000 rays from `distance` away at points within `spread` of `centre`; from
+    /// each hit, a ray leaves `lift` (a sine) off the tangent plane, outward or (with
+    /// `both_sides`) either way. Returns (hits, rays from the bare hit point that find
+    /// `prim` again, spawned rays that do), all with ε = 0.
+    fn refound(
+        prim: &Primitive,
+        centre: Vec3A,
+        distance: f32,
+        spread: f32,
+        lift: f32,
+        both_sides: bool,
+    ) -> (u32, u32, u32) {
         let mut rng = Rng(7);
         let mut next = || rng.range(-0.5, 0.5);
         let finds = |origin: Vec3A, dir: Vec3A| {
             let r = Ray::segment(origin, dir, 0.0, f32::INFINITY);
             prim.intersect(0, &PreparedRay::new(r), f32::INFINITY).is_some()
         };
-        let (mut bare, mut spawned, mut tried) = (0, 0, 0);
+        let (mut tried, mut bare, mut spawned) = (0, 0, 0);
         for _ in 0..20_000 {
-            let origin = centre + Vec3A::new(next(), next(), next()).normalize() * 40.0;
-            let dir = (centre + Vec3A::new(next(), next(), next()) * 5.0 - origin).normalize();
+            let origin = centre + Vec3A::new(next(), next(), next()).normalize() * distance;
+            let dir = (centre + Vec3A::new(next(), next(), next()) * spread - origin).normalize();
             let ray = Ray::segment(origin, dir, 1e-4, f32::INFINITY);
             let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else {
                 continue;
             };
             let sp = prim.surface_point(&hit, origin, dir, &[]);
             let ng = sp.geometric_normal;
+            let side = if both_sides && next() < 0.0 { -ng } else { ng };
             let tangent = ng.cross(Vec3A::new(next(), next(), next())).normalize();
-            let out = (tangent + ng * 1e-3).normalize();
+            let out = (tangent + side * lift).normalize();
             tried += 1;
             bare += finds(sp.point, out) as u32;
             spawned += finds(sp.spawn(out).origin, out) as u32;
         }
+        (tried, bare, spawned)
+    }
+
+    /// A small ellipsoid far from the origin, hit from all sides; rays leave almost along
+    /// the tangent plane, outward. Spawned as `SurfacePoint::spawn` does it, none finds
+    /// the ellipsoid again even with no ε at all; started at the bare hit point, many do
+    /// (so the test can fail).
+    #[test]
+    fn rays_leaving_a_sphere_do_not_find_it_again() {
+        let m = Affine3A::from_translation(glam::Vec3::new(1000.0, -700.0, 300.0))
+            * Affine3A::from_rotation_y(0.3)
+            * Affine3A::from_scale(glam::Vec3::new(3.0, 1.5, 2.0));
+        let prim = Primitive::new(Shape::Sphere(Sphere::new(m)), 0);
+        let (tried, bare, spawned) = refound(&prim, Vec3A::new(1000.0, -700.0, 300.0), 40.0, 5.0, 1e-3, false);
         assert!(tried > 5_000, "{tried}");
         assert_eq!(spawned, 0, "of {tried}");
         assert!(bare > 50, "the test must be able to fail: {bare} of {tried}");
@@ -335,30 +351,7 @@ mod tests {
             Vec3A::new(-1996.0, 509.0, 995.0),
         ];
         let prim = Primitive::new(Shape::Triangle { p, normals: None }, 0);
-        let centre = (p[0] + p[1] + p[2]) / 3.0;
-        let mut rng = Rng(11);
-        let mut next = || rng.range(-0.5, 0.5);
-        let finds = |origin: Vec3A, dir: Vec3A| {
-            let r = Ray::segment(origin, dir, 0.0, f32::INFINITY);
-            prim.intersect(0, &PreparedRay::new(r), f32::INFINITY).is_some()
-        };
-        let (mut bare, mut spawned, mut tried) = (0, 0, 0);
-        for _ in 0..20_000 {
-            let origin = centre + Vec3A::new(next(), next(), next()).normalize() * 30.0;
-            let dir = (centre + Vec3A::new(next(), next(), next()) * 4.0 - origin).normalize();
-            let ray = Ray::segment(origin, dir, 1e-4, f32::INFINITY);
-            let Some(hit) = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY) else {
-                continue;
-            };
-            let sp = prim.surface_point(&hit, origin, dir, &[]);
-            let ng = sp.geometric_normal;
-            let side = if next() < 0.0 { -ng } else { ng };
-            let tangent = ng.cross(Vec3A::new(next(), next(), next())).normalize();
-            let out = (tangent + side * 1e-4).normalize();
-            tried += 1;
-            bare += finds(sp.point, out) as u32;
-            spawned += finds(sp.spawn(out).origin, out) as u32;
-        }
+        let (tried, bare, spawned) = refound(&prim, (p[0] + p[1] + p[2]) / 3.0, 30.0, 4.0, 1e-4, true);
         assert!(tried > 5_000, "{tried}");
         assert_eq!(spawned, 0, "of {tried}");
         assert!(bare > 50, "the test must be able to fail: {bare} of {tried}");
