@@ -1,4 +1,4 @@
-//! `lucent render SCENE [-o OUT.png] [--spp N] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
+//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
 
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -7,7 +7,7 @@ use std::time::Instant;
 use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_core::integrator::whitted::MAX_PENDING;
-use lucent_core::render::job::RenderJob;
+use lucent_core::sampler::SamplerKind;
 use lucent_io::resources::input::FileId;
 use lucent_io::resources::Budget;
 use lucent_io::session::{Renderer, Session, SessionOptions};
@@ -31,6 +31,10 @@ pub struct RenderArgs {
     /// Samples per pixel, instead of the scene's `spp` (as pbrt's --spp).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
     pub spp: Option<u32>,
+    /// The source of random numbers, instead of the scene's `sampler` (default: sobol
+    /// for the Monte Carlo integrators, independent for the others).
+    #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["independent", "sobol"]))]
+    pub sampler: Option<String>,
     /// Acceleration structure.
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
@@ -98,10 +102,18 @@ pub fn run(args: &RenderArgs) -> u8 {
         Ok(r) => r,
         Err(code) => return code,
     };
-    let job = match args.spp {
-        Some(spp) => RenderJob::whole(built.settings.resolution, spp),
-        None => built.job(),
-    };
+    let mut job = built.job();
+    if let Some(spp) = args.spp {
+        job.spp = spp;
+        job.samples = 0..spp;
+    }
+    if let Some(name) = &args.sampler {
+        job.sampler = SamplerKind::ALL
+            .iter()
+            .find(|(n, _)| n == name)
+            .expect("clap checked the value")
+            .1;
+    }
     let progress = Progress::new(job.pixels.pixels() * job.samples.len() as u64, args.quiet);
     let cancel = signals::cancel_flag();
     let t_render = Instant::now();

@@ -6,6 +6,7 @@
 use std::ops::Range;
 
 use crate::camera::Resolution;
+use crate::sampler::SamplerKind;
 
 /// A rectangle of pixels, `x0 ≤ x < x1`, `y0 ≤ y < y1` (row 0 at the top).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -54,10 +55,12 @@ pub struct RenderJob {
     pub samples: Range<u32>,
     /// Picks the random numbers of every sample; 0 is the default.
     pub seed: u64,
+    /// Where the random numbers come from (`sampler`).
+    pub sampler: SamplerKind,
 }
 
 impl RenderJob {
-    /// The whole image with every one of its `spp` samples.
+    /// The whole image with every one of its `spp` samples, independent random numbers.
     pub fn whole(resolution: Resolution, spp: u32) -> RenderJob {
         RenderJob {
             resolution,
@@ -65,6 +68,7 @@ impl RenderJob {
             spp,
             samples: 0..spp,
             seed: 0,
+            sampler: SamplerKind::Independent,
         }
     }
 

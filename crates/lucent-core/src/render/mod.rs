@@ -151,7 +151,7 @@ fn render_tile(
                 if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
                 }
-                let mut sampler = Sampler::new(job.seed, x, y, i);
+                let mut sampler = Sampler::start(job.sampler, job.seed, x, y, i);
                 let (dx, dy) = match sampling {
                     // One sample goes through the pixel centre; more are jittered over
                     // the pixel (one per cell of a √n × √n grid when n is a square).

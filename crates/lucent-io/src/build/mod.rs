@@ -22,9 +22,10 @@ use lucent_core::accel::AccelKind;
 use lucent_core::camera::Resolution;
 use lucent_core::integrator::Integrator;
 use lucent_core::render::job::RenderJob;
+use lucent_core::sampler::SamplerKind;
 use lucent_core::scene::{Scene, SceneParts};
 
-use crate::desc::SceneDesc;
+use crate::desc::{SampleSource, SceneDesc};
 use crate::diag::Diagnostics;
 use crate::resources::Resources;
 
@@ -50,6 +51,8 @@ pub struct RenderSettings {
     pub spp: u32,
     /// `gamma`: the exponent of the 8-bit encoding (1 = none).
     pub gamma: f32,
+    /// `sampler`, or the integrator's default.
+    pub sampler: SamplerKind,
 }
 
 pub struct Built {
@@ -63,7 +66,10 @@ pub struct Built {
 impl Built {
     /// The render the file asks for: the whole image with all its samples.
     pub fn job(&self) -> RenderJob {
-        RenderJob::whole(self.settings.resolution, self.settings.spp)
+        RenderJob {
+            sampler: self.settings.sampler,
+            ..RenderJob::whole(self.settings.resolution, self.settings.spp)
+        }
     }
 }
 
@@ -121,6 +127,10 @@ fn build_parts(
             resolution: Resolution { width, height },
             spp: desc.spp(),
             gamma: desc.gamma() as f32,
+            sampler: match desc.sampler() {
+                SampleSource::Independent => SamplerKind::Independent,
+                SampleSource::Sobol => SamplerKind::Sobol,
+            },
         },
         work,
     })

@@ -26,6 +26,7 @@ const COMMANDS: &[(&str, Run)] = &[
     ("russianroulette", Parser::switch),
     ("nexteventestimation", Parser::next_event_estimation),
     ("importancesampling", Parser::importance_sampling),
+    ("sampler", Parser::sampler),
     // camera.rs
     ("camera", Parser::camera),
     ("orthocamera", Parser::camera),

@@ -1,12 +1,12 @@
 //! Global settings: `size`, `output`, `maxdepth`, `gamma`, and the integrator's
 //! `integrator`, `spp`, `lightsamples`, `lightstratify`, `nexteventestimation`,
-//! `russianroulette`, `importancesampling`. Each is given once (the last one wins, with a
+//! `russianroulette`, `importancesampling`, `sampler`. Each is given once (the last one wins, with a
 //! warning).
 
 use super::lexer::Command;
 use super::parser::Parser;
 use super::MAX_PIXELS;
-use crate::desc::{DirectionSampling, IntegratorKind, Located, NeeMode, SceneDesc};
+use crate::desc::{DirectionSampling, IntegratorKind, Located, NeeMode, SampleSource, SceneDesc};
 
 impl Parser {
     /// `size width height`.
@@ -129,6 +129,15 @@ impl Parser {
             ("brdf", DirectionSampling::Brdf),
         ];
         self.keyword_setting(c, &kinds, |d| &mut d.importance_sampling);
+    }
+
+    /// `sampler independent|sobol`.
+    pub(super) fn sampler(&mut self, c: &Command) {
+        let sources = [
+            ("independent", SampleSource::Independent),
+            ("sobol", SampleSource::Sobol),
+        ];
+        self.keyword_setting(c, &sources, |d| &mut d.sampler);
     }
 
     /// A global setting given as one of the names in `options`, located at its value.

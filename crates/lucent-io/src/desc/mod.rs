@@ -88,6 +88,13 @@ pub enum DirectionSampling {
     Brdf,
 }
 
+/// `sampler independent|sobol`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SampleSource {
+    Independent,
+    Sobol,
+}
+
 /// Everything a scene file says.
 #[derive(Clone, Debug, Default)]
 pub struct SceneDesc {
@@ -106,6 +113,8 @@ pub struct SceneDesc {
     pub next_event_estimation: Option<Located<NeeMode>>,
     pub russian_roulette: Option<Located<bool>>,
     pub importance_sampling: Option<Located<DirectionSampling>>,
+    /// `sampler independent|sobol`.
+    pub sampler: Option<Located<SampleSource>>,
     pub gamma: Option<Located<f64>>,
     /// `lens aperture focusdistance`.
     pub lens: Option<Located<(f64, f64)>>,
@@ -145,6 +154,17 @@ impl SceneDesc {
 
     pub fn spp(&self) -> u32 {
         self.spp.as_ref().map_or(1, |s| s.value)
+    }
+
+    /// The source of random numbers: the scene's `sampler`, else Sobol numbers for the
+    /// Monte Carlo integrators and independent ones for the others (whose pictures
+    /// were made with them).
+    pub fn sampler(&self) -> SampleSource {
+        match (&self.sampler, self.integrator()) {
+            (Some(s), _) => s.value,
+            (None, IntegratorKind::Direct | IntegratorKind::PathTracer) => SampleSource::Sobol,
+            (None, _) => SampleSource::Independent,
+        }
     }
 
     pub fn light_samples(&self) -> u32 {
