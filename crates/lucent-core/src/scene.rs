@@ -86,7 +86,7 @@ impl Scene {
     pub fn bsdf(&self, hit: &Hit, ray: &Ray, sp: &SurfacePoint) -> Bsdf {
         let m = &self.materials[sp.material as usize];
         let shaded = surface::shade(m, &self.textures, sp, || self.tangents(hit, ray));
-        m.bsdf(shaded.normal, shaded.diffuse)
+        m.bsdf(shaded.normal, sp.geometric_normal, shaded.diffuse)
     }
 
     pub fn accel_kind(&self) -> AccelKind {

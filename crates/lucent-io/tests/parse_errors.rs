@@ -212,7 +212,11 @@ fn keywords() {
     );
     assert_eq!(
         first_error("brdf lambert"),
-        "t.test:3:6: error: brdf: unknown value 'lambert' (expected phong or ggx)"
+        "t.test:3:6: error: brdf: unknown value 'lambert' (expected phong, ggx or mirror)"
+    );
+    assert_eq!(
+        first_error("sampler halton"),
+        "t.test:3:9: error: sampler: unknown value 'halton' (expected independent or sobol)"
     );
     let text = format!("{HEADER}lightsamples 8\nlightstratify on\n");
     assert_eq!(

@@ -10,16 +10,22 @@
 //! √N × √N jittered grid with `lightstratify on`) and `f` the material's BRDF. Point and
 //! directional lights get one shadow ray each. No ambient term. A camera ray that hits a
 //! light sees its radiance from the front and black from behind.
+//!
+//! Light sampling cannot reach through a mirror (`brdf mirror`) or glass (`transparent`):
+//! at such a surface the ray follows the delta lobe, up to `maxdepth` times, and the
+//! direct light is estimated where it lands (what pbrt's direct-lighting integrator does).
 
 use super::light_sampling::every_light;
 use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
-use crate::hit::BACKGROUND;
+use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::math::Color;
 use crate::ray::Ray;
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 
 pub struct Direct {
+    /// `maxdepth`: how many mirror or glass surfaces a camera ray may pass through.
+    pub max_delta_bounces: u32,
     /// `lightsamples`.
     pub light_samples: u32,
     /// `lightstratify`.
@@ -27,26 +33,45 @@ pub struct Direct {
 }
 
 impl Integrator for Direct {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
-        let (hit, sp) = match first_hit(scene, ray, counts) {
-            FirstHit::Nothing => return BACKGROUND,
-            FirstHit::Light(radiance) => return radiance,
-            FirstHit::Surface(hit, sp) => (hit, sp),
-        };
-        let bsdf = scene.bsdf(&hit, ray, &sp);
-        let emission = scene.materials[sp.material as usize].emission;
-        let wo = -ray.dir;
-        emission
-            + every_light(
-                scene,
-                &sp,
-                wo,
-                &bsdf,
-                self.light_samples,
-                self.light_stratify,
-                sampler,
-                counts,
-            )
+    fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
+        let mut ray = *camera_ray;
+        let mut weight = Color::ONE;
+        let mut total = Color::ZERO;
+        for bounce in 0.. {
+            let (hit, sp) = match first_hit(scene, &ray, counts) {
+                FirstHit::Nothing => return total + weight * BACKGROUND,
+                FirstHit::Light(radiance) => return total + weight * radiance,
+                FirstHit::Surface(hit, sp) => (hit, sp),
+            };
+            let bsdf = scene.bsdf(&hit, &ray, &sp);
+            let emission = scene.materials[sp.material as usize].emission;
+            total += weight * emission;
+            let wo = -ray.dir;
+            if bsdf.is_delta() {
+                if bounce >= self.max_delta_bounces {
+                    break;
+                }
+                let Some(d) = bsdf.sample_delta(wo, sampler.uniform()) else {
+                    break;
+                };
+                weight *= d.weight;
+                ray = SurfacePoint::spawn(&sp, d.wi);
+                continue;
+            }
+            total += weight
+                * every_light(
+                    scene,
+                    &sp,
+                    wo,
+                    &bsdf,
+                    self.light_samples,
+                    self.light_stratify,
+                    sampler,
+                    counts,
+                );
+            break;
+        }
+        total
     }
 
     fn pixel_sampling(&self) -> PixelSampling {

@@ -18,7 +18,9 @@
 //!
 //! Directions are drawn uniformly on the hemisphere around the shading normal, in
 //! proportion to the cosine, or from the BSDF (`importancesampling`); one below the
-//! surface ends the path. Russian roulette, when about to go on, ends the path with
+//! surface ends the path. A delta BSDF (`brdf mirror`, `transparent` glass) is never
+//! light-sampled: the path follows its lobe, and a light that segment finds adds in full
+//! in every mode (EXTENSIONS.md), even past the last scattering event. Russian roulette, when about to go on, ends the path with
 //! probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
 
 use super::light_sampling::{every_light, one_light_mis};
@@ -109,6 +111,20 @@ impl PathTracer {
         (cos > 0.0 && pdf > 0.0 && x.above_geometry(wi)).then_some(Bounce { wi, f, cos, pdf })
     }
 
+    /// Russian roulette on the throughput `beta` of a path about to go on (not after its
+    /// last scattering event, whose segment only looks for a light); whether it goes on.
+    #[inline]
+    fn go_on(&self, beta: &mut Color, last: bool, sampler: &mut Sampler) -> bool {
+        if self.russian_roulette && !last {
+            let q = 1.0 - beta.max_element().min(1.0);
+            if sampler.uniform() < q {
+                return false;
+            }
+            *beta /= 1.0 - q;
+        }
+        beta.is_finite() && *beta != Color::ZERO
+    }
+
     /// Whether scattering event `k` (at x_k) may happen.
     #[inline]
     fn within_depth(&self, k: u32) -> bool {
@@ -119,14 +135,25 @@ impl PathTracer {
     }
 }
 
+/// How the segment being traced left its last vertex: what a light it finds adds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Came {
+    /// The camera ray: a light seen directly adds in full.
+    Camera,
+    /// A delta lobe (mirror, glass), which light sampling cannot reach: a light found
+    /// adds in full.
+    Delta,
+    /// A BSDF sample of this density (MIS weighs a light it finds against the light
+    /// strategy).
+    Bsdf(f32),
+}
+
 impl Integrator for PathTracer {
     fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
         let mut total = Color::ZERO;
         let mut beta = Color::ONE;
         let mut ray = *camera_ray;
-        // The density of the BSDF strategy for the segment being traced (MIS weighs a
-        // light it finds against the light strategy); None for the camera segment.
-        let mut bsdf_pdf: Option<f32> = None;
+        let mut came = Came::Camera;
         // The index of the vertex the current segment will hit.
         let mut k = 1u32;
         loop {
@@ -137,10 +164,10 @@ impl Integrator for PathTracer {
             let sp = scene.surface_point(&hit, &ray);
             if let Some(index) = sp.light {
                 let le = scene.lights[index as usize].radiance_seen(ray.dir, sp.normal);
-                match (self.nee, bsdf_pdf) {
-                    (Nee::Off, _) | (_, None) => total += beta * le,
-                    (Nee::On, Some(_)) => {} // next-event estimation counted it
-                    (Nee::Mis, Some(p_bsdf)) => {
+                match (self.nee, came) {
+                    (Nee::Off, _) | (_, Came::Camera | Came::Delta) => total += beta * le,
+                    (Nee::On, Came::Bsdf(_)) => {} // next-event estimation counted it
+                    (Nee::Mis, Came::Bsdf(p_bsdf)) => {
                         if le != Color::ZERO {
                             let p_light =
                                 scene.lights[index as usize].pdf_li(hit.t, ray.dir) / scene.lights.len() as f32;
@@ -151,8 +178,9 @@ impl Integrator for PathTracer {
                 break;
             }
             let within = self.within_depth(k);
-            // Past the last scattering event only the path without NEE looks at a hit.
-            if !within && self.nee != Nee::Off {
+            // Past the last scattering event only the path without NEE looks at a hit
+            // (and one that a delta lobe sent, which NEE could not follow).
+            if !within && self.nee != Nee::Off && came != Came::Delta {
                 break;
             }
             let m = &scene.materials[sp.material as usize];
@@ -162,6 +190,22 @@ impl Integrator for PathTracer {
             }
             let bsdf = scene.bsdf(&hit, &ray, &sp);
             let wo = -ray.dir;
+            let last = !self.within_depth(k + 1);
+            if bsdf.is_delta() {
+                // No light sampling through a delta lobe: the path follows it, whatever
+                // `importancesampling` says, and counts the light it finds in full.
+                let Some(d) = bsdf.sample_delta(wo, sampler.uniform()) else {
+                    break;
+                };
+                beta *= d.weight;
+                if !self.go_on(&mut beta, last, sampler) {
+                    break;
+                }
+                ray = sp.spawn(d.wi);
+                came = Came::Delta;
+                k += 1;
+                continue;
+            }
             match self.nee {
                 Nee::Off => {}
                 Nee::On => {
@@ -184,7 +228,6 @@ impl Integrator for PathTracer {
             }
             // With NEE the last scattering event's light is already counted; MIS still
             // traces its BSDF sample to find the light that strategy weighs.
-            let last = !self.within_depth(k + 1);
             if last && self.nee == Nee::On {
                 break;
             }
@@ -192,19 +235,11 @@ impl Integrator for PathTracer {
                 break;
             };
             beta *= b.f * (b.cos / b.pdf);
-            if self.russian_roulette && !last {
-                let q = 1.0 - beta.max_element().min(1.0);
-                let u = sampler.uniform();
-                if u < q {
-                    break;
-                }
-                beta /= 1.0 - q;
-            }
-            if !beta.is_finite() || beta == Color::ZERO {
+            if !self.go_on(&mut beta, last, sampler) {
                 break;
             }
             ray = sp.spawn(b.wi);
-            bsdf_pdf = Some(b.pdf);
+            came = Came::Bsdf(b.pdf);
             k += 1;
         }
         total

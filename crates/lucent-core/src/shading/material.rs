@@ -4,7 +4,7 @@
 //! `roughness` that choose the BSDF of the Monte Carlo integrators ([`super::bsdf`]). In
 //! the Whitted ray tracer `specular` is also the mirror reflectance.
 
-use super::bsdf::{Bsdf, Ggx, Phong};
+use super::bsdf::{Bsdf, Dielectric, Ggx, Mirror, Phong};
 use crate::math::{Color, Vec3A};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,6 +34,8 @@ pub struct Material {
 pub enum BrdfModel {
     Phong,
     Ggx,
+    /// `brdf mirror`: perfect reflection with reflectance `specular`.
+    Mirror,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -70,9 +72,18 @@ impl Default for Material {
 }
 
 impl Material {
-    /// The BSDF at a point with unit shading normal `normal` and (textured) diffuse
-    /// colour `diffuse`.
-    pub fn bsdf(&self, normal: Vec3A, diffuse: Color) -> Bsdf {
+    /// The BSDF at a point with unit shading normal `normal`, the true surface's normal
+    /// `geometric` (on the side of `normal`) and (textured) diffuse colour `diffuse`. A
+    /// `transparent` material is a smooth dielectric, whatever its `brdf`.
+    pub fn bsdf(&self, normal: Vec3A, geometric: Vec3A, diffuse: Color) -> Bsdf {
+        if self.transparent != Color::ZERO {
+            return Bsdf::Dielectric(Dielectric {
+                n: normal,
+                ng: geometric,
+                ior: self.ior,
+                kt: self.transparent,
+            });
+        }
         match self.brdf {
             BrdfModel::Phong => Bsdf::Phong(Phong {
                 n: normal,
@@ -85,6 +96,11 @@ impl Material {
                 kd: diffuse,
                 ks: self.specular,
                 alpha: self.roughness,
+            }),
+            BrdfModel::Mirror => Bsdf::Mirror(Mirror {
+                n: normal,
+                ng: geometric,
+                ks: self.specular,
             }),
         }
     }

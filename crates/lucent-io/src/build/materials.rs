@@ -138,6 +138,7 @@ fn material(m: &MaterialDesc) -> Material {
         brdf: match m.brdf {
             Brdf::Phong => BrdfModel::Phong,
             Brdf::Ggx => BrdfModel::Ggx,
+            Brdf::Mirror => BrdfModel::Mirror,
         },
         roughness: m.roughness as f32,
     }

@@ -87,6 +87,7 @@ pub fn integrator(desc: &SceneDesc, diags: &mut Diagnostics) -> Chosen {
         }),
         IntegratorKind::AnalyticDirect => Chosen::AnalyticDirect(AnalyticDirect),
         IntegratorKind::Direct => Chosen::Direct(Direct {
+            max_delta_bounces: u32::try_from(desc.max_depth()).unwrap_or(UNBOUNDED_DEPTH_CAP),
             light_samples,
             light_stratify,
         }),
@@ -288,17 +289,36 @@ fn check_integrator(desc: &SceneDesc, diags: &mut Diagnostics) {
         }
     }
     if matches!(kind, IntegratorKind::RayTracer | IntegratorKind::AnalyticDirect) {
-        if let Some(s) = desc
-            .shapes
-            .iter()
-            .find(|s| desc.materials[s.material as usize].brdf == Brdf::Ggx)
-        {
-            let how = if kind == IntegratorKind::RayTracer {
-                "it shades with Blinn-Phong"
-            } else {
-                "it shades the diffuse term only"
-            };
-            diags.warning(s.loc, format!("brdf ggx has no effect with integrator {name} ({how})"));
+        for (brdf, model) in [(Brdf::Ggx, "ggx"), (Brdf::Mirror, "mirror")] {
+            if let Some(s) = desc
+                .shapes
+                .iter()
+                .find(|s| desc.materials[s.material as usize].brdf == brdf)
+            {
+                let how = match kind {
+                    IntegratorKind::RayTracer if brdf == Brdf::Mirror => "its mirrors come from 'specular'",
+                    IntegratorKind::RayTracer => "it shades with Blinn-Phong",
+                    _ => "it shades the diffuse term only",
+                };
+                diags.warning(
+                    s.loc,
+                    format!("brdf {model} has no effect with integrator {name} ({how})"),
+                );
+            }
+        }
+    }
+    if matches!(kind, IntegratorKind::Direct | IntegratorKind::PathTracer) {
+        // EXTENSIONS.md: a transparent material is a smooth dielectric there, nothing more.
+        if let Some(s) = desc.shapes.iter().find(|s| {
+            let m = &desc.materials[s.material as usize];
+            m.transparent != glam::DVec3::ZERO && (m.diffuse != glam::DVec3::ZERO || m.specular != glam::DVec3::ZERO)
+        }) {
+            diags.warning(
+                s.loc,
+                format!(
+                    "transparent: with integrator {name} this object is smooth glass; its diffuse and specular colours are not used"
+                ),
+            );
         }
     }
     if kind == IntegratorKind::AnalyticDirect {

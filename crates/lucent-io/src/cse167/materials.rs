@@ -78,9 +78,10 @@ impl Parser {
         self.set_material(|m| m.glossy = Some(glossy));
     }
 
-    /// `brdf phong|ggx`.
+    /// `brdf phong|ggx|mirror`.
     pub(super) fn brdf(&mut self, c: &Command) {
-        if let Some(b) = self.keyword(c, &[("phong", Brdf::Phong), ("ggx", Brdf::Ggx)]) {
+        let models = [("phong", Brdf::Phong), ("ggx", Brdf::Ggx), ("mirror", Brdf::Mirror)];
+        if let Some(b) = self.keyword(c, &models) {
             self.set_material(|m| m.brdf = b);
         }
     }

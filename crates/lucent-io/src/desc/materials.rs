@@ -58,6 +58,7 @@ impl Default for MaterialDesc {
 pub enum Brdf {
     Phong,
     Ggx,
+    Mirror,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]

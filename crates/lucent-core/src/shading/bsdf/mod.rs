@@ -1,6 +1,11 @@
 //! BSDFs: how a surface point scatters light, as `eval`, `sample` and `pdf` (the shape of
 //! pbrt-v4's `BxDF` and Mitsuba 3's `BSDF`, in RGB). One file per model, selected per
-//! object by `brdf phong|ggx` (SCENE_FORMAT.md §4.7).
+//! object by `brdf phong|ggx` (SCENE_FORMAT.md §4.7), plus the delta models of
+//! EXTENSIONS.md: `brdf mirror` and `transparent` with `ior` (a smooth dielectric).
+//!
+//! A delta model scatters into single directions, which no density can describe: its
+//! `eval` and `pdf` are zero (a light sample never finds its lobe, and MIS puts no weight
+//! on it), and integrators draw its direction with [`Bsdf::sample_delta`].
 //!
 //! Directions are world-space unit vectors pointing away from the surface: `wo` toward
 //! the viewer (the previous vertex), `wi` toward the light or the next vertex. The
@@ -10,12 +15,16 @@
 //!
 //! [`Frame`]: crate::sampling::frame::Frame
 
+pub mod dielectric;
 pub mod ggx;
+pub mod mirror;
 pub mod phong;
 
 use crate::math::{Color, Vec3A};
 
+pub use dielectric::Dielectric;
 pub use ggx::Ggx;
+pub use mirror::Mirror;
 pub use phong::Phong;
 
 /// A direction drawn from a BSDF: `f(wo, wi)` and the density with which it was drawn
@@ -28,10 +37,22 @@ pub struct BsdfSample {
     pub pdf: f32,
 }
 
+/// A direction drawn from a delta lobe and the weight it multiplies the path's
+/// throughput by (`f · cos θ / pdf`, which for a delta is finite though its parts are not).
+#[derive(Clone, Copy, Debug)]
+pub struct DeltaSample {
+    pub wi: Vec3A,
+    pub weight: Color,
+    /// Through the surface (refraction) rather than back from it.
+    pub transmitted: bool,
+}
+
 #[derive(Clone, Copy, Debug)]
 pub enum Bsdf {
     Phong(Phong),
     Ggx(Ggx),
+    Mirror(Mirror),
+    Dielectric(Dielectric),
 }
 
 impl Bsdf {
@@ -41,6 +62,25 @@ impl Bsdf {
         match self {
             Bsdf::Phong(b) => b.n,
             Bsdf::Ggx(b) => b.n,
+            Bsdf::Mirror(b) => b.n,
+            Bsdf::Dielectric(b) => b.n,
+        }
+    }
+
+    /// Whether the BSDF scatters into single directions only (mirror, glass).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Bsdf::Mirror(_) | Bsdf::Dielectric(_))
+    }
+
+    /// A direction from a delta BSDF (`pick` chooses between reflection and refraction);
+    /// `None` for the others and when nothing is scattered.
+    #[inline]
+    pub fn sample_delta(&self, wo: Vec3A, pick: f32) -> Option<DeltaSample> {
+        match self {
+            Bsdf::Mirror(b) => b.sample(wo),
+            Bsdf::Dielectric(b) => b.sample(wo, pick),
+            Bsdf::Phong(_) | Bsdf::Ggx(_) => None,
         }
     }
 
@@ -50,6 +90,7 @@ impl Bsdf {
         match self {
             Bsdf::Phong(b) => b.eval(wo, wi),
             Bsdf::Ggx(b) => b.eval(wo, wi),
+            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => Color::ZERO,
         }
     }
 
@@ -59,16 +100,19 @@ impl Bsdf {
         match self {
             Bsdf::Phong(b) => b.pdf(wo, wi),
             Bsdf::Ggx(b) => b.pdf(wo, wi),
+            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => 0.0,
         }
     }
 
     /// A direction drawn in proportion to the BSDF (`importancesampling brdf`): `pick`
-    /// chooses the lobe, `(u, v)` the direction in it. `None` when nothing can be drawn.
+    /// chooses the lobe, `(u, v)` the direction in it. `None` when nothing can be drawn
+    /// (and for delta BSDFs: see [`Bsdf::sample_delta`]).
     #[inline]
     pub fn sample(&self, wo: Vec3A, pick: f32, u: f32, v: f32) -> Option<BsdfSample> {
         match self {
             Bsdf::Phong(b) => b.sample(wo, pick, u, v),
             Bsdf::Ggx(b) => b.sample(wo, pick, u, v),
+            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => None,
         }
     }
 }
