@@ -460,6 +460,35 @@ fn mis_has_a_lower_error_than_either_of_its_strategies() {
 }
 
 #[test]
+fn adaptive_sampling_spends_samples_where_the_noise_is() {
+    // The small box seen from farther back: its open front shows the black background
+    // around it, whose samples are all zero (no spread: those pixels stop at the 16-sample
+    // minimum), while the box's pixels are noisy and take more, up to the 256 cap.
+    let text = small_box("maxdepth 3\nnexteventestimation mis\nnoisethreshold 0.05", 256)
+        .replace("size 32 32", "size 48 32")
+        .replace("camera 0 0 3.2", "camera 0 0 6");
+    let (film, stats) = common::render_film(&text, 2, |_| {});
+    let counts = &film.counts;
+    let mean = stats.samples as f64 / counts.len() as f64;
+    eprintln!(
+        "adaptive: mean {mean:.1}, min {}, max {}",
+        stats.min_pixel_samples, stats.max_pixel_samples
+    );
+    assert_eq!(stats.samples, counts.iter().map(|&n| n as u64).sum::<u64>());
+    // The corner pixel sees the background; the centre sees the lit box.
+    assert_eq!(counts[0], 16);
+    assert!(counts[16 * 48 + 24] > 16);
+    assert!(stats.min_pixel_samples == 16 && stats.max_pixel_samples <= 256 && mean < 200.0);
+    // Each pixel's stop depends on its own samples alone: the same film for any thread
+    // count.
+    let (one, _) = common::render_film(&text, 1, |_| {});
+    assert_eq!(one, film);
+    // A threshold of 0 is uniform sampling.
+    let (_, uniform) = common::render_film(&text, 2, |job| job.noise_threshold = None);
+    assert_eq!(uniform.samples, 256 * 48 * 32);
+}
+
+#[test]
 fn monte_carlo_renders_are_the_same_bytes_for_any_thread_count() {
     let text = small_box(
         "maxdepth -1\nrussianroulette on\nnexteventestimation mis\nimportancesampling brdf",

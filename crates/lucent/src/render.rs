@@ -1,4 +1,4 @@
-//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
+//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--noise-threshold T] [--spp-map FILE] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
 
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -7,6 +7,7 @@ use std::time::Instant;
 use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_core::integrator::whitted::MAX_PENDING;
+use lucent_core::math::Color;
 use lucent_core::sampler::SamplerKind;
 use lucent_io::resources::input::FileId;
 use lucent_io::resources::Budget;
@@ -35,6 +36,15 @@ pub struct RenderArgs {
     /// for the Monte Carlo integrators, independent for the others).
     #[arg(long, value_parser = clap::builder::PossibleValuesParser::new(["independent", "sobol"]))]
     pub sampler: Option<String>,
+    /// Adaptive sampling: stop a pixel once the estimated relative error of its mean
+    /// (luminance) is below T, after at least 16 samples; the scene's `spp` (or `--spp`)
+    /// stays the cap. Instead of the scene's `noisethreshold`; 0 turns it off.
+    #[arg(long, value_name = "T", value_parser = parse_threshold)]
+    pub noise_threshold: Option<f32>,
+    /// Also write the number of samples each pixel took: EXR/HDR with the counts,
+    /// PNG with count / spp.
+    #[arg(long, value_name = "FILE")]
+    pub spp_map: Option<PathBuf>,
     /// Acceleration structure.
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
@@ -50,6 +60,14 @@ pub struct RenderArgs {
     /// Print the time of each phase (parse, build, render, write).
     #[arg(long)]
     pub stats: bool,
+}
+
+/// `--noise-threshold`: a finite number ≥ 0.
+fn parse_threshold(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(t) if t >= 0.0 && t.is_finite() => Ok(t),
+        _ => Err(format!("'{s}' is not a number >= 0")),
+    }
 }
 
 /// `--memory-limit`: a size as people write it (`4G`, `512MiB`, bytes).
@@ -81,16 +99,29 @@ pub fn run(args: &RenderArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    let spp_map = match &args.spp_map {
+        Some(p) => match choose_output(Some(p), &session.desc, &mut session.diags) {
+            Ok(m) => Some(m),
+            Err(msg) => {
+                report(&session.diags, &session.desc.sources, false);
+                eprintln!("lucent: error: --spp-map: {msg}");
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
     let mut named = session.res.inputs.clone();
     for p in session.desc.named_files() {
         if let Ok(meta) = std::fs::metadata(p) {
             named.record(FileId::of(&meta), p);
         }
     }
-    if let Err(e) = out.target.check_not_input(&named) {
-        report(&session.diags, &session.desc.sources, false);
-        eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
-        return EXIT_BAD_INPUT;
+    for o in std::iter::once(&out).chain(&spp_map) {
+        if let Err(e) = o.target.check_not_input(&named) {
+            report(&session.diags, &session.desc.sources, false);
+            eprintln!("lucent: error: cannot write {}: {e}", o.name.display());
+            return EXIT_BAD_INPUT;
+        }
     }
     session.build();
     report(&session.diags, &session.desc.sources, false);
@@ -106,6 +137,9 @@ pub fn run(args: &RenderArgs) -> u8 {
     if let Some(spp) = args.spp {
         job.spp = spp;
         job.samples = 0..spp;
+    }
+    if let Some(t) = args.noise_threshold {
+        job.noise_threshold = (t > 0.0).then_some(t);
     }
     if let Some(name) = &args.sampler {
         job.sampler = SamplerKind::ALL
@@ -147,6 +181,23 @@ pub fn run(args: &RenderArgs) -> u8 {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
+    if let Some(map) = &spp_map {
+        // PNG holds fractions of the cap; the float formats hold the counts themselves.
+        let scale = if map.format == crate::output::Format::Png {
+            1.0 / job.samples.len() as f32
+        } else {
+            1.0
+        };
+        let counts = lucent_core::image::Image {
+            width: film.width,
+            height: film.height,
+            pixels: film.counts.iter().map(|&n| Color::splat(n as f32 * scale)).collect(),
+        };
+        if let Err(e) = crate::output::write_image(map, &counts, 1.0) {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    }
     let t_written = Instant::now();
 
     let scene = &built.scene;
@@ -161,6 +212,15 @@ pub fn run(args: &RenderArgs) -> u8 {
             render_s,
             stats.rays as f64 / render_s.max(1e-9) / 1e6,
             out.name.display()
+        );
+    }
+    if job.noise_threshold.is_some() && !args.quiet {
+        eprintln!(
+            "adaptive sampling: {:.1} samples per pixel on average (min {}, max {}, cap {})",
+            stats.samples as f64 / film.counts.len().max(1) as f64,
+            stats.min_pixel_samples,
+            stats.max_pixel_samples,
+            job.samples.len()
         );
     }
     if args.stats {

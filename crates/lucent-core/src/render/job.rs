@@ -40,7 +40,7 @@ impl PixelRect {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct RenderJob {
     /// The whole image the camera's view is divided into.
     pub resolution: Resolution,
@@ -57,7 +57,17 @@ pub struct RenderJob {
     pub seed: u64,
     /// Where the random numbers come from (`sampler`).
     pub sampler: SamplerKind,
+    /// Adaptive sampling (`noisethreshold`, `--noise-threshold`): a pixel stops taking
+    /// samples once the estimated relative standard error of its mean luminance is
+    /// below this, after at least [`MIN_ADAPTIVE_SAMPLES`] (or all of them); `None`
+    /// takes every sample.
+    pub noise_threshold: Option<f32>,
 }
+
+/// The fewest samples a pixel takes before adaptive sampling may stop it: fewer do not
+/// estimate the spread of its samples well enough (one lucky run of dark samples would
+/// look converged).
+pub const MIN_ADAPTIVE_SAMPLES: u32 = 16;
 
 impl RenderJob {
     /// The whole image with every one of its `spp` samples, independent random numbers.
@@ -69,6 +79,7 @@ impl RenderJob {
             samples: 0..spp,
             seed: 0,
             sampler: SamplerKind::Independent,
+            noise_threshold: None,
         }
     }
 

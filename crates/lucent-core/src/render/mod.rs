@@ -21,7 +21,7 @@ use crate::integrator::{Integrator, PixelSampling, TraceCounts};
 use crate::math::DVec3;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
-use job::RenderJob;
+use job::{RenderJob, MIN_ADAPTIVE_SAMPLES};
 
 pub const TILE_SIZE: u32 = 16;
 /// The most samples per pixel whose lens positions are stratified (a table of this many
@@ -41,6 +41,22 @@ pub struct RenderStats {
     /// Branches of ray trees cut because too many were waiting at once
     /// ([`crate::integrator::whitted::MAX_PENDING`]).
     pub cut_branches: u64,
+    /// Samples taken in all, and the fewest and most that one pixel took (they differ
+    /// with adaptive sampling).
+    pub samples: u64,
+    pub min_pixel_samples: u32,
+    pub max_pixel_samples: u32,
+}
+
+impl RenderStats {
+    fn add(&mut self, other: &RenderStats) {
+        self.rays += other.rays;
+        self.bad_samples += other.bad_samples;
+        self.cut_branches += other.cut_branches;
+        self.samples += other.samples;
+        self.min_pixel_samples = self.min_pixel_samples.min(other.min_pixel_samples);
+        self.max_pixel_samples = self.max_pixel_samples.max(other.max_pixel_samples);
+    }
 }
 
 /// Hooks for the caller: `progress` is called after each tile with the number of samples
@@ -90,7 +106,7 @@ pub fn render(
     // the progress callback's rate gives is honest from the first tiles on; where a
     // tile's pixels land does not depend on it.
     let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
-    let results: Vec<Option<(Vec<DVec3>, RenderStats)>> = order
+    let results: Vec<Option<(Vec<(DVec3, u32)>, RenderStats)>> = order
         .par_iter()
         .map(|&t| {
             if control.cancel.load(Ordering::Relaxed) {
@@ -104,37 +120,38 @@ pub fn render(
 
     let w = rect.width() as usize;
     let mut film = Film::new(rect.width(), rect.height());
-    let mut stats = RenderStats::default();
+    let mut stats = RenderStats {
+        min_pixel_samples: u32::MAX,
+        ..RenderStats::default()
+    };
     for (&t, result) in order.iter().zip(results) {
         let tile = &tiles[t as usize];
         let (pixels, s) = result?;
-        stats.rays += s.rays;
-        stats.bad_samples += s.bad_samples;
-        stats.cut_branches += s.cut_branches;
+        stats.add(&s);
         let tw = (tile.x1 - tile.x0) as usize;
-        let taken = job.samples.len() as u32;
         for (row, chunk) in pixels.chunks(tw).enumerate() {
             let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
-            for (i, sum) in chunk.iter().enumerate() {
-                film.add(start + i, *sum, taken);
+            for (i, &(sum, taken)) in chunk.iter().enumerate() {
+                film.add(start + i, sum, taken);
             }
         }
     }
     Some((film, stats))
 }
 
-/// The sums of the samples of one tile's pixels; `None` as soon as `cancel` is set (it
-/// is looked at between pixels and every [`CANCEL_EVERY`] samples).
+/// The sums of the samples of one tile's pixels and how many each took; `None` as soon
+/// as `cancel` is set (it is looked at between pixels and every [`CANCEL_EVERY`] samples).
 fn render_tile(
     scene: &Scene,
     integrator: &dyn Integrator,
     job: &RenderJob,
     tile: &Tile,
     cancel: &AtomicBool,
-) -> Option<(Vec<DVec3>, RenderStats)> {
+) -> Option<(Vec<(DVec3, u32)>, RenderStats)> {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
+    let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
     let n = job.spp.max(1);
     let sampling = integrator.pixel_sampling();
     // Shuffled lens strata need a table of `spp` entries: beyond MAX_LENS_STRATA samples
@@ -147,6 +164,8 @@ fn render_tile(
                 lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
             }
             let mut sum = DVec3::ZERO;
+            let mut noise = NoiseEstimate::default();
+            let mut taken = 0u32;
             for i in job.samples.clone() {
                 if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
@@ -186,22 +205,73 @@ fn render_tile(
                     .camera
                     .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
                 let c = integrator.radiance(scene, &ray, &mut sampler, &mut counts);
-                if c.is_finite() {
-                    // The box filter: every sample of the pixel counts the same.
-                    sum += c.as_dvec3();
+                let c = if c.is_finite() {
+                    c.as_dvec3()
                 } else {
                     bad_samples += 1;
+                    DVec3::ZERO
+                };
+                // The box filter: every sample of the pixel counts the same.
+                sum += c;
+                taken += 1;
+                if let Some(threshold) = job.noise_threshold {
+                    noise.add(c);
+                    // Looked at every 8 samples: a stop then leaves whole 8-point nets of
+                    // the Sobol sequences, which cover the pixel evenly.
+                    if taken >= MIN_ADAPTIVE_SAMPLES.min(n)
+                        && taken % 8 == 0
+                        && noise.relative_error() < threshold as f64
+                    {
+                        break;
+                    }
                 }
             }
-            pixels.push(sum);
+            pixels.push((sum, taken));
+            taken_min = taken_min.min(taken);
+            taken_max = taken_max.max(taken);
+            taken_all += taken as u64;
         }
     }
     let stats = RenderStats {
         rays: counts.rays,
         bad_samples,
         cut_branches: counts.cut_branches,
+        samples: taken_all,
+        min_pixel_samples: taken_min,
+        max_pixel_samples: taken_max,
     };
     Some((pixels, stats))
+}
+
+/// The running mean and spread of a pixel's luminance, for adaptive sampling.
+#[derive(Default)]
+struct NoiseEstimate {
+    n: f64,
+    sum: f64,
+    sum_sq: f64,
+}
+
+impl NoiseEstimate {
+    fn add(&mut self, c: DVec3) {
+        // Rec. 709 luminance, on the linear radiance.
+        let y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        self.n += 1.0;
+        self.sum += y;
+        self.sum_sq += y * y;
+    }
+
+    /// The standard error of the mean over the mean: 0 for a pixel whose samples are all
+    /// the same (black included), infinite for one with a positive spread and a zero mean.
+    fn relative_error(&self) -> f64 {
+        let mean = self.sum / self.n;
+        let variance = ((self.sum_sq - self.sum * mean) / (self.n - 1.0).max(1.0)).max(0.0);
+        let error = (variance / self.n).sqrt();
+        if error == 0.0 {
+            0.0
+        } else {
+            error / mean.abs()
+        }
+    }
 }
 
 /// `0..n` in an order drawn from the pixel alone (Fisher–Yates), reusing `out`'s storage.

@@ -53,6 +53,8 @@ pub struct RenderSettings {
     pub gamma: f32,
     /// `sampler`, or the integrator's default.
     pub sampler: SamplerKind,
+    /// `noisethreshold`, when positive.
+    pub noise_threshold: Option<f32>,
 }
 
 pub struct Built {
@@ -68,6 +70,7 @@ impl Built {
     pub fn job(&self) -> RenderJob {
         RenderJob {
             sampler: self.settings.sampler,
+            noise_threshold: self.settings.noise_threshold,
             ..RenderJob::whole(self.settings.resolution, self.settings.spp)
         }
     }
@@ -131,6 +134,11 @@ fn build_parts(
                 SampleSource::Independent => SamplerKind::Independent,
                 SampleSource::Sobol => SamplerKind::Sobol,
             },
+            noise_threshold: desc
+                .noise_threshold
+                .as_ref()
+                .map(|t| t.value as f32)
+                .filter(|&t| t > 0.0),
         },
         work,
     })

@@ -27,6 +27,7 @@ const COMMANDS: &[(&str, Run)] = &[
     ("nexteventestimation", Parser::next_event_estimation),
     ("importancesampling", Parser::importance_sampling),
     ("sampler", Parser::sampler),
+    ("noisethreshold", Parser::noise_threshold),
     // camera.rs
     ("camera", Parser::camera),
     ("orthocamera", Parser::camera),

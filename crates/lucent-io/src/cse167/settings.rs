@@ -1,6 +1,6 @@
 //! Global settings: `size`, `output`, `maxdepth`, `gamma`, and the integrator's
 //! `integrator`, `spp`, `lightsamples`, `lightstratify`, `nexteventestimation`,
-//! `russianroulette`, `importancesampling`, `sampler`. Each is given once (the last one wins, with a
+//! `russianroulette`, `importancesampling`, `sampler`, `noisethreshold`. Each is given once (the last one wins, with a
 //! warning).
 
 use super::lexer::Command;
@@ -138,6 +138,20 @@ impl Parser {
             ("sobol", SampleSource::Sobol),
         ];
         self.keyword_setting(c, &sources, |d| &mut d.sampler);
+    }
+
+    /// `noisethreshold t`: t ≥ 0 (0 turns adaptive sampling off).
+    pub(super) fn noise_threshold(&mut self, c: &Command) {
+        let Some([t]) = self.nums::<1>(c) else { return };
+        if !(t >= 0.0) {
+            self.err_arg(c, 0, format!("noisethreshold: must be 0 (off) or positive, got {t}"));
+            return;
+        }
+        let v = Located {
+            value: t,
+            loc: self.loc(c.line, &c.args[0]),
+        };
+        self.set_global(c, |d| &mut d.noise_threshold, v);
     }
 
     /// A global setting given as one of the names in `options`, located at its value.

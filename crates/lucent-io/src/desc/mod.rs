@@ -115,6 +115,8 @@ pub struct SceneDesc {
     pub importance_sampling: Option<Located<DirectionSampling>>,
     /// `sampler independent|sobol`.
     pub sampler: Option<Located<SampleSource>>,
+    /// `noisethreshold t` (0: off).
+    pub noise_threshold: Option<Located<f64>>,
     pub gamma: Option<Located<f64>>,
     /// `lens aperture focusdistance`.
     pub lens: Option<Located<(f64, f64)>>,
