@@ -6,7 +6,8 @@
 //!
 //! The path of one pixel: [`render`] → `render_tile` → for each sample, a point of the
 //! pixel ([`PixelSampling`]) → [`Camera::ray`] → [`Integrator::radiance`] → the sum of
-//! its samples on the film.
+//! its samples on the film. With a noise threshold (`noisethreshold`, adaptive sampling)
+//! a pixel may stop before its last sample, on the evidence of its own samples alone.
 //!
 //! [`Camera::ray`]: crate::camera::Camera::ray
 
