@@ -467,7 +467,7 @@ fn adaptive_sampling_spends_samples_where_the_noise_is() {
     let text = small_box("maxdepth 3\nnexteventestimation mis\nnoisethreshold 0.05", 256)
         .replace("size 32 32", "size 48 32")
         .replace("camera 0 0 3.2", "camera 0 0 6");
-    let (film, stats) = common::render_film(&text, 2, |_| {});
+    let (film, stats) = common::render_film("a.test", &text, 2, |_| {});
     let counts = &film.counts;
     let mean = stats.samples as f64 / counts.len() as f64;
     eprintln!(
@@ -481,10 +481,10 @@ fn adaptive_sampling_spends_samples_where_the_noise_is() {
     assert!(stats.min_pixel_samples == 16 && stats.max_pixel_samples <= 256 && mean < 200.0);
     // Each pixel's stop depends on its own samples alone: the same film for any thread
     // count.
-    let (one, _) = common::render_film(&text, 1, |_| {});
+    let (one, _) = common::render_film("a.test", &text, 1, |_| {});
     assert_eq!(one, film);
     // A threshold of 0 is uniform sampling.
-    let (_, uniform) = common::render_film(&text, 2, |job| job.noise_threshold = None);
+    let (_, uniform) = common::render_film("a.test", &text, 2, |job| job.noise_threshold = None);
     assert_eq!(uniform.samples, 256 * 48 * 32);
 }
 

@@ -17,7 +17,7 @@
 
 use super::light_sampling::every_light;
 use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
-use crate::hit::{SurfacePoint, BACKGROUND};
+use crate::hit::BACKGROUND;
 use crate::math::Color;
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -55,7 +55,7 @@ impl Integrator for Direct {
                     break;
                 };
                 weight *= d.weight;
-                ray = SurfacePoint::spawn(&sp, d.wi);
+                ray = sp.spawn(d.wi);
                 continue;
             }
             total += weight

@@ -43,7 +43,7 @@ use crate::math::{Color, Vec3A};
 use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
-use crate::shading::optics::{fresnel_dielectric, lift_above, phong_lobe, reflect, refract};
+use crate::shading::optics::{fresnel_dielectric, lift_above, phong_lobe, reflect_above, refract, side_of};
 use crate::shading::surface;
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
@@ -192,12 +192,7 @@ impl Whitted {
             let (d, n) = (ray.dir, sp.normal);
             // The side of the true surface the ray came from: reflected rays must leave
             // on it and refracted rays on the other, whatever the shading normal says.
-            let ng = sp.geometric_normal;
-            let (viewer, viewer_cos) = if d.dot(ng) <= 0.0 {
-                (ng, -d.dot(ng))
-            } else {
-                (-ng, d.dot(ng))
-            };
+            let viewer = side_of(-d, sp.geometric_normal);
             let mut mirror = m.specular;
             let mut refracted = None;
             if m.transparent != Color::ZERO {
@@ -229,7 +224,7 @@ impl Whitted {
             let reflected = if mirror == Color::ZERO || negligible {
                 None
             } else {
-                let r = lift_above(reflect(d, n).normalize(), viewer, (0.9 * viewer_cos).min(0.01));
+                let r = reflect_above(-d, n, viewer);
                 Some(match m.glossy {
                     Some(g) => {
                         let count = if depth == 0 { g.samples.max(1) } else { 1 };

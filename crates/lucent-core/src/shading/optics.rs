@@ -58,6 +58,25 @@ pub fn lift_above(w: Vec3A, side: Vec3A, height: f32) -> Vec3A {
     (along * ((1.0 - height * height).max(0.0).sqrt() / len) + side * height).normalize()
 }
 
+/// `ng` or `-ng`: the side of the true surface (unit normal `ng`) that `wo` (unit, away
+/// from the surface) is on.
+#[inline]
+pub fn side_of(wo: Vec3A, ng: Vec3A) -> Vec3A {
+    if wo.dot(ng) >= 0.0 {
+        ng
+    } else {
+        -ng
+    }
+}
+
+/// The mirror direction of the viewer direction `wo` (unit, away from the surface) about
+/// the shading normal `n`, kept on the viewer's side `viewer` of the true surface
+/// ([`lift_above`]: just above it, or closer for a grazing view).
+#[inline]
+pub fn reflect_above(wo: Vec3A, n: Vec3A, viewer: Vec3A) -> Vec3A {
+    lift_above(reflect(-wo, n).normalize(), viewer, (0.9 * wo.dot(viewer)).min(0.01))
+}
+
 /// A direction drawn around the unit axis `r` with density ∝ `cos^exponent` of the angle
 /// to it (the Phong lobe), from two uniform numbers.
 pub fn phong_lobe(r: Vec3A, exponent: f32, u: f32, v: f32) -> Vec3A {

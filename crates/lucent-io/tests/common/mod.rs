@@ -76,29 +76,19 @@ pub fn render_job(
     text: &str,
     edit: impl FnOnce(&mut lucent_core::render::job::RenderJob),
 ) -> lucent_core::image::Image {
-    use lucent_io::session::{Renderer, Session, SessionOptions};
-    let mut session = Session::parse_text(scene, text.as_bytes(), SessionOptions::default());
-    session.build();
-    let built = session
-        .built
-        .as_ref()
-        .unwrap_or_else(|| panic!("{}", session.diags.render(&session.desc.sources)));
-    let mut job = built.job();
-    edit(&mut job);
-    let cancel = std::sync::atomic::AtomicBool::new(false);
-    let renderer = Renderer::new(Some(2)).unwrap();
-    renderer.render(built, &job, &|_| {}, &cancel).unwrap().0.resolve()
+    render_film(scene, text, 2, edit).0.resolve()
 }
 
 /// The film and statistics of the job the scene asks for, changed by `edit`, with
 /// `threads` worker threads; panics with the diagnostics on any error.
 pub fn render_film(
+    scene: &str,
     text: &str,
     threads: usize,
     edit: impl FnOnce(&mut lucent_core::render::job::RenderJob),
 ) -> (lucent_core::film::Film, lucent_core::render::RenderStats) {
     use lucent_io::session::{Renderer, Session, SessionOptions};
-    let mut session = Session::parse_text("f.test", text.as_bytes(), SessionOptions::default());
+    let mut session = Session::parse_text(scene, text.as_bytes(), SessionOptions::default());
     session.build();
     let built = session
         .built

@@ -7,7 +7,7 @@
 
 use super::DeltaSample;
 use crate::math::{Color, Vec3A};
-use crate::shading::optics::{fresnel_dielectric, lift_above, reflect, refract};
+use crate::shading::optics::{fresnel_dielectric, lift_above, reflect_above, refract, side_of};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Dielectric {
@@ -34,12 +34,10 @@ impl Dielectric {
         let f = fresnel_dielectric(cos_o.abs(), n_i, n_t);
         // The viewer's side of the true surface: reflected rays leave on it, refracted
         // rays on the other, whatever the shading normal says.
-        let viewer = if wo.dot(self.ng) >= 0.0 { self.ng } else { -self.ng };
+        let viewer = side_of(wo, self.ng);
         if pick < f {
-            let wi = reflect(-wo, facing).normalize();
-            let height = (0.9 * wo.dot(viewer)).min(0.01);
             return Some(DeltaSample {
-                wi: lift_above(wi, viewer, height),
+                wi: reflect_above(wo, facing, viewer),
                 weight: Color::ONE,
                 transmitted: false,
             });

@@ -3,7 +3,7 @@
 
 use super::DeltaSample;
 use crate::math::{Color, Vec3A};
-use crate::shading::optics::{lift_above, reflect};
+use crate::shading::optics::{reflect_above, side_of};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Mirror {
@@ -18,11 +18,8 @@ pub struct Mirror {
 impl Mirror {
     /// The mirror direction, kept on the viewer's side of the true surface.
     pub fn sample(&self, wo: Vec3A) -> Option<DeltaSample> {
-        let viewer = if wo.dot(self.ng) >= 0.0 { self.ng } else { -self.ng };
-        let wi = reflect(-wo, self.n).normalize();
-        let height = (0.9 * wo.dot(viewer)).min(0.01);
         (self.ks != Color::ZERO).then(|| DeltaSample {
-            wi: lift_above(wi, viewer, height),
+            wi: reflect_above(wo, self.n, side_of(wo, self.ng)),
             weight: self.ks,
             transmitted: false,
         })
