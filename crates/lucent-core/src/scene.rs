@@ -7,8 +7,10 @@ use crate::camera::Camera;
 use crate::geometry::primitive::Primitive;
 use crate::geometry::Geometry;
 use crate::hit::{Hit, SurfacePoint};
-use crate::light::Light;
-use crate::math::Vec3A;
+use crate::light::emitters::EmissiveSurfaces;
+use crate::light::environment::EnvironmentLight;
+use crate::light::{Light, SampledLight};
+use crate::math::{Color, Vec3A};
 use crate::ray::Ray;
 use crate::shading::bsdf::Bsdf;
 use crate::shading::material::Material;
@@ -26,6 +28,13 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// `envmap`: what rays that hit nothing see (black without one).
     pub environment: Option<EnvironmentMap>,
+    /// The Monte Carlo integrators' light of every emissive surface (`emission`), if
+    /// any can be sampled.
+    pub emitters: Option<EmissiveSurfaces>,
+    /// Materials that emit on shapes light sampling cannot reach, `(material, shape)`.
+    pub unsampled_emitters: Vec<(u32, &'static str)>,
+    /// The Monte Carlo integrators' environment light (`envmap`), unless it is black.
+    pub environment_light: Option<EnvironmentLight>,
     accel_kind: AccelKind,
 }
 
@@ -51,6 +60,7 @@ impl Scene {
             textures,
             environment,
         } = parts;
+        let found = EmissiveSurfaces::new(&primitives, &materials);
         Scene {
             camera,
             geometry: Geometry::new(primitives, vertex_normals, accel),
@@ -58,7 +68,43 @@ impl Scene {
             materials,
             lights,
             textures,
+            environment_light: environment.as_ref().and_then(EnvironmentLight::new),
             environment,
+            emitters: found.light,
+            unsampled_emitters: found.unsampled,
+        }
+    }
+
+    /// What a ray travelling along `dir` that hits nothing sees: the environment map, or
+    /// black.
+    #[inline]
+    pub fn background(&self, dir: Vec3A) -> Color {
+        match &self.environment {
+            Some(env) => env.radiance(dir),
+            None => Color::ZERO,
+        }
+    }
+
+    /// How many lights next-event estimation chooses among (the Monte Carlo
+    /// integrators): the scene's lights, then all emissive surfaces as one, then the
+    /// environment.
+    #[inline]
+    pub fn sampled_light_count(&self) -> usize {
+        self.lights.len() + self.emitters.is_some() as usize + self.environment_light.is_some() as usize
+    }
+
+    /// Light i of [`Scene::sampled_light_count`].
+    #[inline]
+    pub fn sampled_light(&self, i: usize) -> SampledLight<'_> {
+        if let Some(l) = self.lights.get(i) {
+            return SampledLight::Listed(l);
+        }
+        match (&self.emitters, i - self.lights.len()) {
+            (Some(e), 0) => SampledLight::Emitters(e),
+            _ => SampledLight::Environment(
+                self.environment_light.as_ref().expect("a light index within the count"),
+                self.environment.as_ref().expect("an environment light has its map"),
+            ),
         }
     }
 

@@ -9,7 +9,10 @@
 //! with `pdf = R² / (A · cos θ_light)` (a uniform point `y_m` on the parallelogram, on a
 //! √N × √N jittered grid with `lightstratify on`) and `f` the material's BRDF. Point and
 //! directional lights get one shadow ray each. No ambient term. A camera ray that hits a
-//! light sees its radiance from the front and black from behind.
+//! light sees its radiance from the front and black from behind; one that hits nothing
+//! sees the environment (`envmap`). The sum runs over every light of the Monte Carlo
+//! integrators: all emissive surfaces together are one, the environment another
+//! (EXTENSIONS.md).
 //!
 //! Light sampling cannot reach through a mirror (`brdf mirror`) or glass (`transparent`):
 //! at such a surface the ray follows the delta lobe, up to `maxdepth` times, and the
@@ -17,7 +20,6 @@
 
 use super::light_sampling::every_light;
 use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
-use crate::hit::BACKGROUND;
 use crate::math::Color;
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -39,7 +41,7 @@ impl Integrator for Direct {
         let mut total = Color::ZERO;
         for bounce in 0.. {
             let (hit, sp) = match first_hit(scene, &ray, counts) {
-                FirstHit::Nothing => return total + weight * BACKGROUND,
+                FirstHit::Nothing => return total + weight * scene.background(ray.dir),
                 FirstHit::Light(radiance) => return total + weight * radiance,
                 FirstHit::Surface(hit, sp) => (hit, sp),
             };

@@ -3,6 +3,9 @@
 //! points on every light, stratified with `lightstratify on`) and the light half of
 //! multiple importance sampling (§4.6: one light chosen uniformly, weighted by the power
 //! heuristic against the BSDF strategy's density).
+//!
+//! "Every light" is every light of [`Scene::sampled_light`]: the scene's listed lights,
+//! all emissive surfaces as one light and the environment (EXTENSIONS.md).
 
 use super::TraceCounts;
 use crate::hit::SurfacePoint;
@@ -47,13 +50,17 @@ pub fn every_light(
     counts: &mut TraceCounts,
 ) -> Color {
     let mut total = Color::ZERO;
-    for light in &scene.lights {
+    for i in 0..scene.sampled_light_count() {
+        let light = scene.sampled_light(i);
         let n = if light.is_delta() { 1 } else { samples.max(1) };
         let mut sum = Color::ZERO;
         for k in 0..n {
+            // Only a light made of pieces draws a number to choose one (so the numbers
+            // of the course's quad-light scenes are the ones they always were).
+            let pick = if light.has_pieces() { sampler.uniform() } else { 0.0 };
             let (u, v) = sampler.uniform2();
             let (u, v) = if stratify { stratified(k, n, u, v) } else { (u, v) };
-            let Some(s) = light.sample_li(x.point, u, v) else {
+            let Some(s) = light.sample_li(x.point, pick, u, v) else {
                 continue;
             };
             let c = unshadowed(x, bsdf, wo, &s);
@@ -77,14 +84,17 @@ pub fn one_light_mis(
     sampler: &mut Sampler,
     counts: &mut TraceCounts,
 ) -> Color {
-    let count = scene.lights.len();
+    let count = scene.sampled_light_count();
     let pick = sampler.uniform();
     let (u, v) = sampler.uniform2();
     if count == 0 {
         return Color::ZERO;
     }
-    let light = &scene.lights[((pick * count as f32) as usize).min(count - 1)];
-    let Some(mut s) = light.sample_li(x.point, u, v) else {
+    let scaled = pick * count as f32;
+    let index = (scaled as usize).min(count - 1);
+    // What is left of `pick` within the chosen light chooses its piece.
+    let rest = (scaled - index as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+    let Some(mut s) = scene.sampled_light(index).sample_li(x.point, rest, u, v) else {
         return Color::ZERO;
     };
     // The density of choosing this light and this point on it.

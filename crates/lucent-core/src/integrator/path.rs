@@ -4,24 +4,29 @@
 //!
 //! The camera ray is segment 0; it hits x1; scattering at x_k makes segment k, which
 //! hits x_{k+1}. β is the throughput, the product of `f · cos θ / pdf` of the scattering
-//! events so far. A path that hits a light ends there. `maxdepth` N bounds the number of
-//! scattering events (−1: unbounded, ended by Russian roulette):
+//! events so far. `maxdepth` N bounds the number of scattering events (−1: unbounded,
+//! ended by Russian roulette). The lights a segment can find (EXTENSIONS.md): the front
+//! of a quad light (a path ends there), either side of an emissive surface (`emission`,
+//! which also scatters) and the environment (`envmap`, when the segment escapes).
 //!
-//! - **`off`**: a light hit by any segment adds `β · Le` (its front; its back is black);
-//!   every ordinary hit adds `β · E` and scatters while k ≤ N.
+//! - **`off`**: a light found by any segment adds `β · Le`; every ordinary hit scatters
+//!   while k ≤ N.
 //! - **`on`**: a light adds `Le` only when the camera sees it; every ordinary hit x_k with
-//!   k ≤ N adds `β · (E + L_direct)` (the `direct` integrator's estimator, with
-//!   `lightsamples` and `lightstratify`) and scatters while k < N.
-//! - **`mis`**: at x_k (k ≤ N), one light sample and one BSDF sample, weighted by the
-//!   power heuristic; the BSDF sample is also the direction the path goes on in (while
-//!   k < N), and a light it finds adds its weighted share, nothing more.
+//!   k ≤ N adds `β · L_direct` (the `direct` integrator's estimator over every light,
+//!   with `lightsamples` and `lightstratify`) and scatters while k < N.
+//! - **`mis`**: at x_k (k ≤ N), one light sample (one light chosen uniformly) and one
+//!   BSDF sample, weighted by the power heuristic; the BSDF sample is also the direction
+//!   the path goes on in (while k < N), and a light it finds adds its weighted share.
+//!
+//! An emissive shape that light sampling cannot draw (a plane, a quadric) is counted in
+//! full by the paths that find it, in every mode.
 //!
 //! Directions are drawn uniformly on the hemisphere around the shading normal, in
 //! proportion to the cosine, or from the BSDF (`importancesampling`); one below the
 //! surface ends the path. A delta BSDF (`brdf mirror`, `transparent` glass) is never
 //! light-sampled: the path follows its lobe, and a light that segment finds adds in full
-//! in every mode (EXTENSIONS.md), even past the last scattering event. Russian roulette, when about to go on, ends the path with
-//! probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
+//! in every mode (EXTENSIONS.md), even past the last scattering event. Russian
+//! roulette, when about to go on, ends the path with probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
 
 use super::light_sampling::{every_light, one_light_mis};
 use super::{Integrator, PixelSampling, TraceCounts};
@@ -125,6 +130,21 @@ impl PathTracer {
         beta.is_finite() && *beta != Color::ZERO
     }
 
+    /// The weight of the light a path segment finds, which left its vertex as `came`
+    /// says: in full without NEE, after the camera and after a delta lobe, and for a
+    /// light that light sampling never draws (`sampled` false); nothing after a BSDF
+    /// sample with NEE on (it counted that light); with MIS, the power heuristic against
+    /// `p_light`, the density with which light sampling draws the same direction.
+    #[inline]
+    fn found_weight(&self, came: Came, sampled: bool, p_light: impl FnOnce() -> f32) -> f32 {
+        match (self.nee, came) {
+            (Nee::Off, _) | (_, Came::Camera | Came::Delta) => 1.0,
+            _ if !sampled => 1.0,
+            (Nee::On, Came::Bsdf(_)) => 0.0,
+            (Nee::Mis, Came::Bsdf(p_bsdf)) => power_heuristic(p_bsdf, p_light()),
+        }
+    }
+
     /// Whether scattering event `k` (at x_k) may happen.
     #[inline]
     fn within_depth(&self, k: u32) -> bool {
@@ -159,33 +179,42 @@ impl Integrator for PathTracer {
         loop {
             counts.rays += 1;
             let Some(hit) = scene.closest_hit(&ray) else {
-                break; // the background is black
-            };
-            let sp = scene.surface_point(&hit, &ray);
-            if let Some(index) = sp.light {
-                let le = scene.lights[index as usize].radiance_seen(ray.dir, sp.normal);
-                match (self.nee, came) {
-                    (Nee::Off, _) | (_, Came::Camera | Came::Delta) => total += beta * le,
-                    (Nee::On, Came::Bsdf(_)) => {} // next-event estimation counted it
-                    (Nee::Mis, Came::Bsdf(p_bsdf)) => {
-                        if le != Color::ZERO {
-                            let p_light =
-                                scene.lights[index as usize].pdf_li(hit.t, ray.dir) / scene.lights.len() as f32;
-                            total += beta * le * power_heuristic(p_bsdf, p_light);
-                        }
+                // The environment (black without one), a light like any other.
+                if let Some(env) = &scene.environment {
+                    let le = env.radiance(ray.dir);
+                    if le != Color::ZERO {
+                        let p_light = || {
+                            scene.environment_light.as_ref().map_or(0.0, |l| l.pdf_li(ray.dir))
+                                / scene.sampled_light_count() as f32
+                        };
+                        total += beta * le * self.found_weight(came, scene.environment_light.is_some(), p_light);
                     }
                 }
                 break;
-            }
-            let within = self.within_depth(k);
-            // Past the last scattering event only the path without NEE looks at a hit
-            // (and one that a delta lobe sent, which NEE could not follow).
-            if !within && self.nee != Nee::Off && came != Came::Delta {
+            };
+            let sp = scene.surface_point(&hit, &ray);
+            if let Some(index) = sp.light {
+                let light = &scene.lights[index as usize];
+                let le = light.radiance_seen(ray.dir, sp.normal);
+                if le != Color::ZERO {
+                    let p_light = || light.pdf_li(hit.t, ray.dir) / scene.sampled_light_count() as f32;
+                    total += beta * le * self.found_weight(came, true, p_light);
+                }
                 break;
             }
             let m = &scene.materials[sp.material as usize];
-            total += beta * m.emission;
-            if !within {
+            if m.emission != Color::ZERO {
+                // An emissive surface: part of the emitters' light unless its shape
+                // cannot be sampled (then only paths find it, and count it in full).
+                let light = scene.emitters.as_ref().filter(|e| e.samples(sp.material));
+                let p_light = || {
+                    light.map_or(0.0, |e| e.pdf_li(m.emission, sp.geometric_normal, hit.t, ray.dir))
+                        / scene.sampled_light_count() as f32
+                };
+                total += beta * m.emission * self.found_weight(came, light.is_some(), p_light);
+            }
+            // Past the last scattering event a path only looks for light.
+            if !self.within_depth(k) {
                 break;
             }
             let bsdf = scene.bsdf(&hit, &ray, &sp);

@@ -2,11 +2,13 @@
 //! integrators draw from, with the density of each: directions on the hemisphere
 //! (uniform, cosine-weighted, a Phong lobe, GGX half vectors), the orthonormal frame
 //! around a normal they are drawn in, and the power heuristic that weighs two strategies
-//! (multiple importance sampling). Points on quad lights are in [`crate::light`].
+//! (multiple importance sampling), and piecewise-constant distributions over intervals
+//! and grids ([`distribution`]: environment-map texels, emissive primitives). Points on quad lights are in [`crate::light`].
 //!
 //! Every routine here has a χ² goodness-of-fit test against its own density
 //! ([`chi2`], used by the BSDF and light tests too).
 
+pub mod distribution;
 pub mod frame;
 pub mod mis;
 pub mod warp;

@@ -7,8 +7,49 @@
 //! the radiance arriving along it and its solid-angle density, or a delta for point and
 //! directional lights); a quad light also gives the density of a direction that a BSDF
 //! sample found it along ([`QuadLight::pdf_li`]), for multiple importance sampling.
+//!
+//! The Monte Carlo integrators have two more lights: every emissive surface together
+//! ([`emitters`]: `emission`, OBJ `Ke`) and the environment ([`environment`]: `envmap`).
+//! [`SampledLight`] is any of them, as light sampling sees it.
+
+pub mod emitters;
+pub mod environment;
 
 use crate::math::{Color, Vec3A};
+use crate::shading::texture::EnvironmentMap;
+use emitters::EmissiveSurfaces;
+use environment::EnvironmentLight;
+
+/// A light that next-event estimation draws from: a light of the scene's list, all
+/// emissive surfaces, or the environment.
+#[derive(Clone, Copy, Debug)]
+pub enum SampledLight<'a> {
+    Listed(&'a Light),
+    Emitters(&'a EmissiveSurfaces),
+    Environment(&'a EnvironmentLight, &'a EnvironmentMap),
+}
+
+impl SampledLight<'_> {
+    pub fn is_delta(&self) -> bool {
+        matches!(self, SampledLight::Listed(l) if l.is_delta())
+    }
+
+    /// Whether a sample needs `pick` (a choice among the light's pieces) besides its
+    /// point `(u, v)`.
+    pub fn has_pieces(&self) -> bool {
+        matches!(self, SampledLight::Emitters(_))
+    }
+
+    /// A sample of the light seen from `x` (see [`LightSample`]).
+    #[inline]
+    pub fn sample_li(&self, x: Vec3A, pick: f32, u: f32, v: f32) -> Option<LightSample> {
+        match self {
+            SampledLight::Listed(l) => l.sample_li(x, u, v),
+            SampledLight::Emitters(e) => e.sample_li(x, pick, u, v),
+            SampledLight::Environment(e, map) => e.sample_li(map, u, v),
+        }
+    }
+}
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
