@@ -255,9 +255,10 @@ impl Integrator for PathTracer {
                     total += beta * one_light_mis(scene, &sp, wo, &bsdf, pdf, sampler, counts);
                 }
             }
-            // With NEE the last scattering event's light is already counted; MIS still
-            // traces its BSDF sample to find the light that strategy weighs.
-            if last && self.nee == Nee::On {
+            // With NEE the last scattering event's light is already counted (unless
+            // some emitter cannot be light-sampled: then the path looks for it); MIS
+            // still traces its BSDF sample to find the light that strategy weighs.
+            if last && self.nee == Nee::On && scene.unsampled_emitters.is_empty() {
                 break;
             }
             let Some(b) = self.bounce(&sp, &bsdf, wo, sampler) else {

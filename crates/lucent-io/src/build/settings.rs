@@ -13,7 +13,7 @@ use lucent_core::integrator::Integrator;
 use lucent_core::math::Color;
 use lucent_core::scene::Scene;
 
-use crate::desc::{Brdf, DirectionSampling, IntegratorKind, LightKind, NeeMode, SceneDesc};
+use crate::desc::{Brdf, DirectionSampling, IntegratorKind, LightKind, NeeMode, SceneDesc, ShapeKind};
 use crate::diag::{Diagnostics, Loc};
 
 /// `maxdepth -1` (unbounded) is capped here when nothing else ends a path: a closed
@@ -317,6 +317,20 @@ fn check_integrator(desc: &SceneDesc, diags: &mut Diagnostics) {
                 s.loc,
                 format!(
                     "transparent: with integrator {name} this object is smooth glass; its diffuse and specular colours are not used"
+                ),
+            );
+        }
+        // EXTENSIONS.md: emissive objects are a light that NEE samples by area; an
+        // unbounded plane and a quadric have no area to draw from.
+        if let Some(s) = desc.shapes.iter().find(|s| {
+            desc.materials[s.material as usize].emission != glam::DVec3::ZERO
+                && matches!(s.kind, ShapeKind::Plane { .. } | ShapeKind::Quadric { .. })
+        }) {
+            let what = if matches!(s.kind, ShapeKind::Plane { .. }) { "plane" } else { "quadric" };
+            diags.warning(
+                s.loc,
+                format!(
+                    "emission: light sampling cannot draw points on a {what}; with integrator {name} only the paths that hit it (and every other object of this material) count its light"
                 ),
             );
         }
