@@ -10,6 +10,8 @@
   bricks.png             a brick wall (diffuse map), 8-bit sRGB
   bricks_height.png      its height field for bump mapping (mortar low, bricks high)
   sky.png                an equirectangular sky: blue gradient, a horizon, a sun toward -z
+  sky.hdr                a linear sky with a bright sun (Radiance HDR): the light of the
+                         path-traced scene
 
 Run from the repository root: python3 scripts/make_models.py
 """
@@ -198,6 +200,47 @@ def sky(path, w=512, h=256):
     write_png(path, w, h, pixel)
 
 
+def write_hdr(path, width, height, pixel):
+    """A minimal Radiance HDR writer: flat (uncompressed) RGBE scanlines, top row first."""
+
+    def rgbe(c):
+        m = max(c)
+        if m < 1e-32:
+            return b"\x00\x00\x00\x00"
+        mant, e = math.frexp(m)
+        scale = mant * 256.0 / m
+        return bytes([min(255, int(x * scale)) for x in c] + [e + 128])
+
+    with open(path, "wb") as f:
+        f.write(b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y %d +X %d\n" % (height, width))
+        f.write(b"".join(rgbe(pixel(x, y)) for y in range(height) for x in range(width)))
+
+
+def sky_hdr(path, w=512, h=256):
+    """Linear radiance: a blue zenith paling toward the horizon, a brown ground, and a sun
+    of angular radius 2.5 degrees at 35 degrees elevation, from the back left of a camera
+    looking along -z (about two thirds of the light falling on a floor)."""
+    sun = (-0.6, math.sin(math.radians(35)), -0.6)
+    n = math.sqrt(sum(a * a for a in sun))
+    sun = tuple(a / n for a in sun)
+    cos_sun = math.cos(math.radians(2.5))
+
+    def pixel(x, y):
+        u, v = (x + 0.5) / w, (y + 0.5) / h
+        phi = (u - 0.5) * 2 * math.pi
+        theta = v * math.pi
+        d = (math.sin(theta) * math.sin(phi), math.cos(theta), -math.sin(theta) * math.cos(phi))
+        if sum(a * b for a, b in zip(d, sun)) > cos_sun:
+            return (1500.0, 1370.0, 1120.0)
+        if d[1] < 0:
+            return (0.16, 0.13, 0.10)
+        t = d[1] ** 0.5
+        horizon, zenith = (0.85, 0.9, 1.0), (0.2, 0.4, 0.95)
+        return tuple(0.9 * (a + (b - a) * t) for a, b in zip(horizon, zenith))
+
+    write_hdr(path, w, h, pixel)
+
+
 if __name__ == "__main__":
     os.makedirs(OUT, exist_ok=True)
     torus(os.path.join(OUT, "torus.obj"), os.path.join(OUT, "torus.mtl"))
@@ -208,3 +251,4 @@ if __name__ == "__main__":
     bricks(os.path.join(OUT, "bricks.png"))
     bricks_height(os.path.join(OUT, "bricks_height.png"))
     sky(os.path.join(OUT, "sky.png"))
+    sky_hdr(os.path.join(OUT, "sky.hdr"))
