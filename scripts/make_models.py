@@ -11,7 +11,9 @@
   bricks_height.png      its height field for bump mapping (mortar low, bricks high)
   sky.png                an equirectangular sky: blue gradient, a horizon, a sun toward -z
   sky.hdr                a linear sky with a bright sun (Radiance HDR): the light of the
-                         path-traced scene
+                         path-traced scenes
+  dusk.hdr               a uniform dusky blue (Radiance HDR): what the showcase's mirrors
+                         see above the scene, whichever way is up
 
 Run from the repository root: python3 scripts/make_models.py
 """
@@ -218,12 +220,12 @@ def write_hdr(path, width, height, pixel):
 
 def sky_hdr(path, w=512, h=256):
     """Linear radiance: a blue zenith paling toward the horizon, a brown ground, and a sun
-    of angular radius 2.5 degrees at 35 degrees elevation, from the back left of a camera
+    of angular radius 4 degrees at 35 degrees elevation, from the back left of a camera
     looking along -z (about two thirds of the light falling on a floor)."""
     sun = (-0.6, math.sin(math.radians(35)), -0.6)
     n = math.sqrt(sum(a * a for a in sun))
     sun = tuple(a / n for a in sun)
-    cos_sun = math.cos(math.radians(2.5))
+    cos_sun = math.cos(math.radians(4))
 
     def pixel(x, y):
         u, v = (x + 0.5) / w, (y + 0.5) / h
@@ -231,7 +233,7 @@ def sky_hdr(path, w=512, h=256):
         theta = v * math.pi
         d = (math.sin(theta) * math.sin(phi), math.cos(theta), -math.sin(theta) * math.cos(phi))
         if sum(a * b for a, b in zip(d, sun)) > cos_sun:
-            return (1500.0, 1370.0, 1120.0)
+            return (590.0, 535.0, 440.0)
         if d[1] < 0:
             return (0.16, 0.13, 0.10)
         t = d[1] ** 0.5
@@ -252,3 +254,4 @@ if __name__ == "__main__":
     bricks_height(os.path.join(OUT, "bricks_height.png"))
     sky(os.path.join(OUT, "sky.png"))
     sky_hdr(os.path.join(OUT, "sky.hdr"))
+    write_hdr(os.path.join(OUT, "dusk.hdr"), 4, 2, lambda x, y: (0.22, 0.27, 0.42))

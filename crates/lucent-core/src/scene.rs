@@ -7,7 +7,7 @@ use crate::camera::Camera;
 use crate::geometry::primitive::Primitive;
 use crate::geometry::Geometry;
 use crate::hit::{Hit, SurfacePoint};
-use crate::light::emitters::EmissiveSurfaces;
+use crate::light::emitters::{EmissiveSurfaces, Emitters};
 use crate::light::environment::EnvironmentLight;
 use crate::light::{Light, SampledLight};
 use crate::math::{Color, Vec3A};
@@ -47,6 +47,9 @@ pub struct SceneParts {
     pub vertex_normals: Vec<[Vec3A; 3]>,
     pub textures: Vec<Texture>,
     pub environment: Option<EnvironmentMap>,
+    /// Whether to build the Monte Carlo integrators' lights of emissive surfaces and of
+    /// the environment (their tables cost memory the other integrators do not need).
+    pub sampled_lights: bool,
 }
 
 impl Scene {
@@ -59,8 +62,16 @@ impl Scene {
             vertex_normals,
             textures,
             environment,
+            sampled_lights,
         } = parts;
-        let found = EmissiveSurfaces::new(&primitives, &materials);
+        let found = if sampled_lights {
+            EmissiveSurfaces::new(&primitives, &materials)
+        } else {
+            Emitters {
+                light: None,
+                unsampled: Vec::new(),
+            }
+        };
         Scene {
             camera,
             geometry: Geometry::new(primitives, vertex_normals, accel),
@@ -68,7 +79,7 @@ impl Scene {
             materials,
             lights,
             textures,
-            environment_light: environment.as_ref().and_then(EnvironmentLight::new),
+            environment_light: environment.as_ref().filter(|_| sampled_lights).and_then(EnvironmentLight::new),
             environment,
             emitters: found.light,
             unsampled_emitters: found.unsampled,
@@ -163,6 +174,7 @@ mod tests {
             vertex_normals: Vec::new(),
             textures: Vec::new(),
             environment: None,
+            sampled_lights: false,
         };
         Scene::new(parts, accel)
     }

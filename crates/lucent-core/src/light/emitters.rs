@@ -53,7 +53,8 @@ pub struct Emitters {
 #[derive(Clone, Debug)]
 enum Piece {
     Triangle([Vec3A; 3]),
-    Mapped(Mapped),
+    /// Boxed: a triangle (48 bytes) should not pay for its size.
+    Mapped(Box<Mapped>),
 }
 
 /// A surface of object space under an affine transform.
@@ -253,7 +254,7 @@ fn collect(
             }
             Shape::Sphere(s) if emits(prim.material) => {
                 out.push((
-                    Piece::Mapped(Mapped::new(ObjectSurface::Sphere, compose(s.object_to_world))),
+                    Piece::Mapped(Box::new(Mapped::new(ObjectSurface::Sphere, compose(s.object_to_world)))),
                     prim.material,
                 ));
             }
@@ -288,7 +289,7 @@ fn collect(
                         continue;
                     }
                 };
-                out.push((Piece::Mapped(Mapped::new(surface, to)), prim.material));
+                out.push((Piece::Mapped(Box::new(Mapped::new(surface, to))), prim.material));
             }
             Shape::Mesh(m) => {
                 let mesh = &m.mesh;

@@ -25,7 +25,7 @@ use lucent_core::render::job::RenderJob;
 use lucent_core::sampler::SamplerKind;
 use lucent_core::scene::{Scene, SceneParts};
 
-use crate::desc::{SampleSource, SceneDesc};
+use crate::desc::{IntegratorKind, SampleSource, SceneDesc};
 use crate::diag::Diagnostics;
 use crate::resources::Resources;
 
@@ -108,6 +108,14 @@ fn build_parts(
     let mut geometry = geometry::primitives(desc, &mut materials, &view, res, diags);
     let lights = lights::lights(desc, &mut geometry.primitives, &mut materials.materials, diags);
     let camera = camera?;
+    // The Monte Carlo integrators sample emissive surfaces and the environment as lights.
+    let sampled_lights = matches!(desc.integrator(), IntegratorKind::Direct | IntegratorKind::PathTracer);
+    if let (true, Some(env), Some(desc_env)) = (sampled_lights, &environment, &desc.environment) {
+        let cells = 64 * env.image.width as u64 * env.image.height as u64;
+        if let Err(e) = res.budget.take(cells, "the environment light's sampling tables") {
+            diags.error(desc_env.value.file.loc, format!("envmap: {e}"));
+        }
+    }
     if diags.has_errors() {
         return None;
     }
@@ -119,6 +127,7 @@ fn build_parts(
         vertex_normals: geometry.vertex_normals,
         textures: materials.textures,
         environment,
+        sampled_lights,
     };
     let scene = Scene::new(parts, options.accel);
     settings::control_depth(&mut integrator, &scene, desc.gamma() as f32);
