@@ -462,6 +462,29 @@ fn textures_and_tessellations_are_held_to_the_budget_before_they_are_made() {
     assert!(!r.stderr.contains(":7:1: error"), "the first five fit: {}", r.stderr);
 }
 
+/// A flat (uncompressed) Radiance HDR file of `width × height` texels of one colour.
+fn flat_hdr(width: u32, height: u32) -> Vec<u8> {
+    let mut out = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n").into_bytes();
+    out.extend([128u8, 128, 128, 129].repeat((width * height) as usize));
+    out
+}
+
+#[test]
+fn the_environment_lights_tables_are_held_to_the_budget_in_the_monte_carlo_integrators() {
+    // A 2048 × 1024 sky decodes to 25 MB; its sampling tables (64 bytes a texel) need
+    // 134 MB more, and only the Monte Carlo integrators build them.
+    let dir = workdir("envbudget");
+    fs::write(dir.join("sky.hdr"), flat_hdr(2048, 1024)).unwrap();
+    let head = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\n";
+    fs::write(dir.join("pt.test"), format!("{head}integrator pathtracer\nenvmap sky.hdr\n")).unwrap();
+    let r = run(&dir, &["check", "pt.test", "--memory-limit", "100M"], seconds(20));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    says(&r, "pt.test:4:8: error: envmap: the environment light's sampling tables needs about 134 MB");
+    fs::write(dir.join("rt.test"), format!("{head}envmap sky.hdr\n")).unwrap();
+    let r = run(&dir, &["check", "rt.test", "--memory-limit", "100M"], seconds(20));
+    assert_eq!(r.code, Some(0), "the ray tracer needs no tables: {}", r.stderr);
+}
+
 #[test]
 fn an_allocation_that_fails_anyway_exits_with_code_2() {
     let dir = workdir("oom");

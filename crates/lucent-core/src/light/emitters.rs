@@ -7,8 +7,8 @@
 //! light-sampling density from the material alone, without finding the piece.
 //!
 //! The pieces are world-space triangles (plain triangles, every emissive triangle of a
-//! mesh — a 100,000-triangle mesh is 100,000 pieces in one cumulative table, drawn by a
-//! binary search — the twelve triangles of a `box`, and all of these inside instances),
+//! mesh — a 100,000-triangle mesh is 100,000 pieces in one alias table, drawn in
+//! constant time — the twelve triangles of a `box`, and all of these inside instances),
 //! and spheres, disks, cylinders and cones under their affine transforms. Those are drawn
 //! uniformly in object space and kept with probability s / s_max, where s = |det M| ·
 //! |M⁻ᵀ n| is how much the transform M stretches the area around the point: uniform by
@@ -25,7 +25,7 @@ use crate::geometry::analytic::AnalyticKind;
 use crate::geometry::primitive::{Primitive, Shape};
 use crate::light::LightSample;
 use crate::math::{Affine3A, Color, Mat3A, Vec3A};
-use crate::sampling::distribution::Distribution1D;
+use crate::sampling::distribution::AliasTable;
 use crate::shading::material::Material;
 use crate::shading::texture::luminance;
 
@@ -35,7 +35,7 @@ pub struct EmissiveSurfaces {
     pieces: Vec<Piece>,
     /// Each piece's radiance (its material's emission).
     radiance: Vec<Color>,
-    choose: Distribution1D,
+    choose: AliasTable,
     /// Σ area × luminance(E) over the pieces.
     power: f64,
     /// Per material: whether its emission is part of this light.
@@ -324,12 +324,13 @@ impl EmissiveSurfaces {
             .iter()
             .map(|(p, m)| p.area() * luminance(materials[*m as usize].emission))
             .collect();
-        let light = Distribution1D::new(weights).map(|choose| {
+        let power: f64 = weights.iter().map(|&w| w as f64).sum();
+        let light = AliasTable::new(&weights).map(|choose| {
             let (pieces, piece_materials): (Vec<Piece>, Vec<u32>) = found.into_iter().unzip();
             EmissiveSurfaces {
                 radiance: piece_materials.iter().map(|&m| materials[m as usize].emission).collect(),
                 pieces,
-                power: choose.total(),
+                power,
                 choose,
                 sampled,
             }
@@ -354,7 +355,7 @@ impl EmissiveSurfaces {
     /// A point of the light seen from `x`: `pick` chooses the piece, `(u, v)` the point.
     #[inline]
     pub fn sample_li(&self, x: Vec3A, pick: f32, u: f32, v: f32) -> Option<LightSample> {
-        let (i, _, _) = self.choose.sample_discrete(pick);
+        let i = self.choose.sample(pick);
         let (y, normal) = self.pieces[i].point(u, v)?;
         let to_light = y - x;
         let r2 = to_light.length_squared();
