@@ -1,17 +1,61 @@
-//! The film: per pixel, the sum of its samples' radiance (f64, in the order the samples
-//! were taken) and their count. Sums, not averages, so that a render can take more
-//! samples later and two renders of disjoint pixels or sample ranges can be merged;
-//! [`Film::resolve`] divides them into the [`Image`] that is written.
+//! The film: per pixel, the sum of its samples' radiance and their count. Sums, not
+//! averages, so that a render can take more samples later and two renders of disjoint
+//! pixels or sample ranges can be merged; [`Film::resolve`] divides them into the
+//! [`Image`] that is written.
+//!
+//! The sums are exact ([`ExactSum`]): adding samples in another grouping — the first 64
+//! here and the next 64 on another machine, merged — gives the very same bits as adding
+//! them one after the other, which floating-point sums would not.
 
 use crate::image::Image;
 use crate::math::{Color, DVec3};
+
+/// A sum of radiance samples that does not depend on the order or grouping of the
+/// additions: each channel is a fixed-point number with 64 fractional bits in an i128.
+/// A sample's f32 value is converted exactly when it is at least 2⁻⁴¹ (below, it is
+/// rounded to a multiple of 2⁻⁶⁴, the same way every time) and clamped to ±2⁴⁰ (10¹², a
+/// radiance no scene makes), so that even 2²³ samples at that clamp cannot overflow.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct ExactSum(pub [i128; 3]);
+
+/// 2⁶⁴: the fixed point's unit.
+const ONE: f64 = 18_446_744_073_709_551_616.0;
+const LIMIT: f64 = 1_099_511_627_776.0; // 2⁴⁰
+
+impl ExactSum {
+    #[inline]
+    fn fixed(v: f32) -> i128 {
+        ((v as f64).clamp(-LIMIT, LIMIT) * ONE).round() as i128
+    }
+
+    /// Adds one sample (a finite colour).
+    #[inline]
+    pub fn add_sample(&mut self, c: Color) {
+        self.0[0] += Self::fixed(c.x);
+        self.0[1] += Self::fixed(c.y);
+        self.0[2] += Self::fixed(c.z);
+    }
+
+    /// Adds another sum (of other samples of the same pixel).
+    #[inline]
+    pub fn add(&mut self, other: &ExactSum) {
+        for k in 0..3 {
+            self.0[k] += other.0[k];
+        }
+    }
+
+    /// The sum as f64 (rounded once, to nearest).
+    pub fn value(&self) -> DVec3 {
+        DVec3::new(self.0[0] as f64 / ONE, self.0[1] as f64 / ONE, self.0[2] as f64 / ONE)
+    }
+}
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
     /// Row-major, top row first.
-    pub sums: Vec<DVec3>,
+    pub sums: Vec<ExactSum>,
     pub counts: Vec<u32>,
 }
 
@@ -21,15 +65,15 @@ impl Film {
         Film {
             width,
             height,
-            sums: vec![DVec3::ZERO; n],
+            sums: vec![ExactSum::default(); n],
             counts: vec![0; n],
         }
     }
 
     /// Adds a pixel's `count` samples, whose radiance sums to `sum`.
     #[inline]
-    pub fn add(&mut self, index: usize, sum: DVec3, count: u32) {
-        self.sums[index] += sum;
+    pub fn add(&mut self, index: usize, sum: &ExactSum, count: u32) {
+        self.sums[index].add(sum);
         self.counts[index] += count;
     }
 
@@ -41,8 +85,7 @@ impl Film {
             .zip(&self.counts)
             .map(|(s, &n)| match n {
                 0 => Color::ZERO,
-                1 => s.as_vec3().into(),
-                n => (*s / n as f64).as_vec3().into(),
+                n => (s.value() / n as f64).as_vec3().into(),
             })
             .collect();
         Image {
@@ -57,13 +100,44 @@ impl Film {
 mod tests {
     use super::*;
 
+    fn sum_of(samples: &[Color]) -> ExactSum {
+        let mut s = ExactSum::default();
+        samples.iter().for_each(|&c| s.add_sample(c));
+        s
+    }
+
     #[test]
     fn sums_resolve_to_means() {
         let mut f = Film::new(2, 1);
-        f.add(0, DVec3::new(1.0, 2.0, 3.0), 1);
-        f.add(0, DVec3::new(1.0, 0.0, 1.0), 3);
+        f.add(0, &sum_of(&[Color::new(1.0, 2.0, 3.0)]), 1);
+        f.add(0, &sum_of(&[Color::new(1.0, 0.0, 1.0), Color::ZERO, Color::ZERO]), 3);
         let img = f.resolve();
         assert_eq!(img.pixels[0], Color::new(0.5, 0.5, 1.0));
         assert_eq!(img.pixels[1], Color::ZERO);
+    }
+
+    #[test]
+    fn exact_sums_do_not_depend_on_grouping() {
+        // Values of every magnitude, where f64 sums in two groups and in one go differ.
+        let mut x = 0x1234_5678u32;
+        let samples: Vec<Color> = (0..1000)
+            .map(|_| {
+                x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                let e = (x >> 24) as i32 % 40 - 20;
+                Color::splat((x & 0xffff) as f32 / 65536.0 * 2f32.powi(e))
+            })
+            .collect();
+        let whole = sum_of(&samples);
+        for cut in [1, 333, 999] {
+            let mut parts = sum_of(&samples[..cut]);
+            parts.add(&sum_of(&samples[cut..]));
+            assert_eq!(parts, whole, "cut at {cut}");
+        }
+        // Exact for ordinary values: 0.1 + 0.2 in f32, converted once.
+        let s = sum_of(&[Color::splat(0.1), Color::splat(0.2)]);
+        assert_eq!(s.value().x, 0.1f32 as f64 + 0.2f32 as f64);
+        // Huge values are clamped, not wrapped.
+        let big = sum_of(&[Color::splat(f32::MAX), Color::splat(f32::MAX)]);
+        assert_eq!(big.value().x, 2.0 * LIMIT);
     }
 }

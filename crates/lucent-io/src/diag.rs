@@ -41,6 +41,24 @@ impl SourceMap {
         let f = self.files.get(loc.file as usize)?;
         f.lines.get((loc.line as usize).checked_sub(1)?).map(|s| s.as_str())
     }
+
+    /// A 64-bit FNV-1a hash of every line of every file, in order: what render state
+    /// files record as "the scene" (the files a scene reads besides its own text, meshes
+    /// and images, are not part of it).
+    pub fn digest(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for f in &self.files {
+            for line in &f.lines {
+                for &b in line.as_bytes().iter().chain(b"\n") {
+                    h ^= b as u64;
+                    h = h.wrapping_mul(0x0000_0100_0000_01b3);
+                }
+            }
+            h ^= 0xff;
+            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        h
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]

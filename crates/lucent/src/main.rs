@@ -1,9 +1,12 @@
 //! `lucent`: the command line. `render` makes a picture of a scene, `check` validates one
-//! and says what it holds, `diff` compares two images, `bench` measures speed.
+//! and says what it holds, `diff` compares two images, `merge` puts render states
+//! together, `bench` measures speed.
 
 mod bench;
 mod check;
 mod diff;
+mod job_args;
+mod merge;
 mod oom;
 mod output;
 mod progress;
@@ -39,6 +42,8 @@ enum Command {
     Check(check::CheckArgs),
     /// Compare two images (PNG or JPEG) pixel by pixel.
     Diff(diff::DiffArgs),
+    /// Combine render state files (regions, sample ranges) into one image.
+    Merge(merge::MergeArgs),
     /// Benchmarks (figures for docs/performance.md).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -50,6 +55,7 @@ fn main() -> ExitCode {
         Command::Render(a) => render::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Diff(a) => diff::run(&a),
+        Command::Merge(a) => merge::run(&a),
         Command::Bench(c) => bench::run(&c),
     };
     ExitCode::from(code)

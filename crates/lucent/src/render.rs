@@ -1,4 +1,8 @@
-//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--noise-threshold T] [--spp-map FILE] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]`
+//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--noise-threshold T] [--spp-map FILE] [--crop X0 X1 Y0 Y1 | --pixel-bounds X0 X1 Y0 Y1] [--samples FIRST..LAST] [--seed N] [--state OUT.lstate] [--resume STATE] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]
+//!
+//! A render of part of the image (a region), of some sample indices or continued from a
+//! state file gives exactly the pixels of the one-go render: merged (`lucent merge`) the
+//! parts are its bytes.`
 
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
@@ -8,13 +12,18 @@ use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_core::integrator::whitted::MAX_PENDING;
 use lucent_core::math::Color;
+use lucent_core::film::Film;
+use lucent_core::integrator::PixelSampling;
+use lucent_core::render::job::RenderJob;
 use lucent_core::sampler::SamplerKind;
 use lucent_io::resources::input::FileId;
-use lucent_io::resources::Budget;
+use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::session::{Renderer, Session, SessionOptions};
+use lucent_io::state::{RenderState, StateHeader};
 
 use crate::output::{choose_output, report};
 use crate::progress::Progress;
+use crate::job_args::{apply_samples, parse_samples, pixel_rect};
 use crate::signals;
 use crate::EXIT_BAD_INPUT;
 
@@ -45,6 +54,30 @@ pub struct RenderArgs {
     /// PNG with count / spp.
     #[arg(long, value_name = "FILE")]
     pub spp_map: Option<PathBuf>,
+    /// Render only this part of the image, as fractions of its width and height (pbrt's
+    /// cropwindow; pixel edges are the fractions times the size, rounded up). The output
+    /// holds the region alone.
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"], conflicts_with = "pixel_bounds")]
+    pub crop: Option<Vec<f64>>,
+    /// Render only these pixels: columns X0..X1 and rows Y0..Y1, ends exclusive (row 0 at
+    /// the top).
+    #[arg(long, num_args = 4, value_names = ["X0", "X1", "Y0", "Y1"])]
+    pub pixel_bounds: Option<Vec<u32>>,
+    /// Take only these sample indices in every pixel, both ends included (0..63: the
+    /// first 64); renders of several ranges merge into the whole (`lucent merge`).
+    #[arg(long, value_name = "FIRST..LAST", value_parser = parse_samples)]
+    pub samples: Option<std::ops::Range<u32>>,
+    /// Another set of random numbers (the same seed gives the same bytes); default 0.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+    /// Also write the render's state (exact sample sums and counts, with the scene's
+    /// hash and the options) for `lucent merge` and `--resume`.
+    #[arg(long, value_name = "OUT.lstate")]
+    pub state: Option<PathBuf>,
+    /// Continue the render a state file holds, up to `--spp` (or the scene's spp)
+    /// samples per pixel: the same pixels, the sample indices after its last.
+    #[arg(long, value_name = "STATE", conflicts_with_all = ["crop", "pixel_bounds", "samples"])]
+    pub resume: Option<PathBuf>,
     /// Acceleration structure.
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
@@ -110,16 +143,34 @@ pub fn run(args: &RenderArgs) -> u8 {
         },
         None => None,
     };
+    let state_out = match &args.state {
+        Some(p) => match OutputTarget::resolve(p) {
+            Ok(t) => Some((p.clone(), t)),
+            Err(e) => {
+                eprintln!("lucent: error: --state: cannot write {}: {e}", p.display());
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
     let mut named = session.res.inputs.clone();
     for p in session.desc.named_files() {
         if let Ok(meta) = std::fs::metadata(p) {
             named.record(FileId::of(&meta), p);
         }
     }
-    for o in std::iter::once(&out).chain(&spp_map) {
-        if let Err(e) = o.target.check_not_input(&named) {
+    if let Some(r) = &args.resume {
+        if let Ok(meta) = std::fs::metadata(r) {
+            named.record(FileId::of(&meta), r);
+        }
+    }
+    let targets = std::iter::once((&out.name, &out.target))
+        .chain(spp_map.iter().map(|m| (&m.name, &m.target)))
+        .chain(state_out.iter().map(|(n, t)| (n, t)));
+    for (name, target) in targets {
+        if let Err(e) = target.check_not_input(&named) {
             report(&session.diags, &session.desc.sources, false);
-            eprintln!("lucent: error: cannot write {}: {e}", o.name.display());
+            eprintln!("lucent: error: cannot write {}: {e}", name.display());
             return EXIT_BAD_INPUT;
         }
     }
@@ -148,16 +199,76 @@ pub fn run(args: &RenderArgs) -> u8 {
             .expect("clap checked the value")
             .1;
     }
+    if let Some(seed) = args.seed {
+        job.seed = seed;
+    }
+    let pixel_sampling = match built.integrator.pixel_sampling() {
+        PixelSampling::Uniform => "uniform",
+        PixelSampling::Stratified => "stratified",
+    };
+    let header = |job: &RenderJob| StateHeader {
+        scene_hash: session.desc.sources.digest(),
+        resolution: (job.resolution.width, job.resolution.height),
+        pixels: job.pixels,
+        spp: job.spp,
+        samples: job.samples.clone(),
+        seed: job.seed,
+        sampler: SamplerKind::ALL
+            .iter()
+            .find(|(_, k)| *k == job.sampler)
+            .map_or("independent", |(n, _)| n)
+            .to_string(),
+        pixel_sampling: pixel_sampling.to_string(),
+        gamma: built.settings.gamma,
+    };
+    let (w, h) = (job.resolution.width, job.resolution.height);
+    let part = pixel_rect(args.crop.as_deref(), args.pixel_bounds.as_deref(), w, h)
+        .and_then(|rect| {
+            if let Some(r) = rect {
+                job.pixels = r;
+            }
+            args.samples.as_ref().map_or(Ok(()), |s| apply_samples(&mut job, s))
+        })
+        .and_then(|()| {
+            let split = args.samples.is_some() || args.resume.is_some() || args.state.is_some();
+            if job.noise_threshold.is_some() && split {
+                return Err("adaptive sampling (--noise-threshold, noisethreshold) cannot be split into sample ranges, resumed or kept in a state file yet".into());
+            }
+            Ok(())
+        });
+    if let Err(e) = part {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
+    }
+    let now = header(&job);
+    let resumed = match &args.resume {
+        Some(path) => match resume(path, &mut job, &now) {
+            Ok(s) => Some(s),
+            Err(e) => {
+                eprintln!("lucent: error: --resume {}: {e}", path.display());
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
     let progress = Progress::new(job.pixels.pixels() * job.samples.len() as u64, args.quiet);
     let cancel = signals::cancel_flag();
     let t_render = Instant::now();
     let rendered = renderer.render(built, &job, &|n| progress.advance(n), cancel);
     let t_rendered = Instant::now();
     progress.finish();
-    let Some((film, stats)) = rendered.filter(|_| !cancel.load(Ordering::Relaxed)) else {
+    let Some((mut film, stats)) = rendered.filter(|_| !cancel.load(Ordering::Relaxed)) else {
         eprintln!("lucent: interrupted; nothing written");
         return signals::exit_code();
     };
+    let mut kept = header(&job);
+    if let Some(earlier) = resumed {
+        // The earlier samples' sums come first: exact sums make the order irrelevant.
+        kept.samples = earlier.header.samples.start..job.samples.end;
+        let mut total = earlier.film;
+        add_film(&mut total, &film);
+        film = total;
+    }
 
     if stats.bad_samples > 0 {
         eprintln!(
@@ -195,6 +306,13 @@ pub fn run(args: &RenderArgs) -> u8 {
         };
         if let Err(e) = crate::output::write_image(map, &counts, 1.0) {
             eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    }
+    if let Some((name, target)) = &state_out {
+        let state = RenderState { header: kept, film: film.clone() };
+        if let Err(e) = target.write(&state.encode()) {
+            eprintln!("lucent: error: cannot write {}: {e}", name.display());
             return EXIT_BAD_INPUT;
         }
     }
@@ -237,6 +355,46 @@ pub fn run(args: &RenderArgs) -> u8 {
         );
     }
     0
+}
+
+/// Reads the state to continue and points `job` at what is left: its pixels, the sample
+/// indices from its end to `job.spp`. The state must be of this scene and these options,
+/// from an integrator whose samples do not depend on the total (the Monte Carlo ones).
+fn resume(path: &std::path::Path, job: &mut RenderJob, now: &StateHeader) -> Result<RenderState, String> {
+    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    let state = RenderState::decode(&bytes)?;
+    let h = &state.header;
+    let differs = [
+        (h.scene_hash != now.scene_hash, "the scene's text has changed"),
+        (h.resolution != now.resolution, "the image size differs"),
+        (h.seed != now.seed, "the seed differs"),
+        (h.sampler != now.sampler, "the sampler differs"),
+        (h.gamma.to_bits() != now.gamma.to_bits(), "the gamma differs"),
+    ];
+    if let Some((_, why)) = differs.iter().find(|(d, _)| *d) {
+        return Err(format!("it is not a render of this scene with these options: {why}"));
+    }
+    if h.pixel_sampling != "uniform" || h.spp < 2 || now.pixel_sampling != "uniform" {
+        return Err("only renders of the Monte Carlo integrators (direct, pathtracer) with spp 2 or more can be continued: the ray tracer places its samples on a grid that depends on spp, and spp 1 is the pixel centre".into());
+    }
+    if job.spp <= h.samples.end {
+        return Err(format!(
+            "it already holds samples {}..{}; ask for more with --spp (above {})",
+            h.samples.start,
+            h.samples.end - 1,
+            h.samples.end
+        ));
+    }
+    job.pixels = h.pixels;
+    job.samples = h.samples.end..job.spp;
+    Ok(state)
+}
+
+/// Adds `more`'s sums and counts to `film` (the same pixels).
+fn add_film(film: &mut Film, more: &Film) {
+    for (i, (s, &n)) in more.sums.iter().zip(&more.counts).enumerate() {
+        film.add(i, s, n);
+    }
 }
 
 /// Worker threads for `--threads N` (all cores without it), or the exit code after

@@ -48,6 +48,7 @@ const IO: Floors = &[
     ("patches", 3),
     ("texture_file", 3),
     ("image", 3),
+    ("state", 3),
     ("build", 4),
     ("session", 5),
 ];
@@ -57,9 +58,11 @@ const CLI: Floors = &[
     ("progress", 0),
     ("signals", 0),
     ("oom", 0),
+    ("job_args", 0),
     ("render", 1),
     ("check", 1),
     ("diff", 1),
+    ("merge", 1),
     ("bench", 1),
 ];
 

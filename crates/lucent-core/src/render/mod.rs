@@ -17,9 +17,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
-use crate::film::Film;
+use crate::film::{ExactSum, Film};
 use crate::integrator::{Integrator, PixelSampling, TraceCounts};
-use crate::math::DVec3;
+use crate::math::{Color, DVec3};
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
 use job::{RenderJob, MIN_ADAPTIVE_SAMPLES};
@@ -107,7 +107,7 @@ pub fn render(
     // the progress callback's rate gives is honest from the first tiles on; where a
     // tile's pixels land does not depend on it.
     let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
-    let results: Vec<Option<(Vec<(DVec3, u32)>, RenderStats)>> = order
+    let results: Vec<Option<(Vec<(ExactSum, u32)>, RenderStats)>> = order
         .par_iter()
         .map(|&t| {
             if control.cancel.load(Ordering::Relaxed) {
@@ -132,8 +132,8 @@ pub fn render(
         let tw = (tile.x1 - tile.x0) as usize;
         for (row, chunk) in pixels.chunks(tw).enumerate() {
             let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
-            for (i, &(sum, taken)) in chunk.iter().enumerate() {
-                film.add(start + i, sum, taken);
+            for (i, (sum, taken)) in chunk.iter().enumerate() {
+                film.add(start + i, sum, *taken);
             }
         }
     }
@@ -148,7 +148,7 @@ fn render_tile(
     job: &RenderJob,
     tile: &Tile,
     cancel: &AtomicBool,
-) -> Option<(Vec<(DVec3, u32)>, RenderStats)> {
+) -> Option<(Vec<(ExactSum, u32)>, RenderStats)> {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
@@ -164,7 +164,7 @@ fn render_tile(
             if shuffle_lens {
                 lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
             }
-            let mut sum = DVec3::ZERO;
+            let mut sum = ExactSum::default();
             let mut noise = NoiseEstimate::default();
             let mut taken = 0u32;
             for i in job.samples.clone() {
@@ -207,16 +207,16 @@ fn render_tile(
                     .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
                 let c = integrator.radiance(scene, &ray, &mut sampler, &mut counts);
                 let c = if c.is_finite() {
-                    c.as_dvec3()
+                    c
                 } else {
                     bad_samples += 1;
-                    DVec3::ZERO
+                    Color::ZERO
                 };
                 // The box filter: every sample of the pixel counts the same.
-                sum += c;
+                sum.add_sample(c);
                 taken += 1;
                 if let Some(threshold) = job.noise_threshold {
-                    noise.add(c);
+                    noise.add(c.as_dvec3());
                     // Looked at every 8 samples: a stop then leaves whole 8-point nets of
                     // the Sobol sequences, which cover the pixel evenly.
                     if taken >= MIN_ADAPTIVE_SAMPLES.min(n)

@@ -1,0 +1,363 @@
+//! Render state files (`--state OUT.lstate`): the exact per-pixel sample sums and counts
+//! of a render of some pixels and some sample indices, with what they belong to, so that
+//! renders can be merged (`lucent merge`) and continued (`--resume`) into the very bytes
+//! of a render made in one go.
+//!
+//! The format (docs/long-renders.md): a text header of `key value` lines —
+//!
+//! ```text
+//! lucent-state 1
+//! scene 9f3a…            (a 64-bit hash of the scene's text, every file of it)
+//! resolution 640 480
+//! pixels 0 640 0 240     (x0 x1 y0 y1, ends exclusive)
+//! spp 256
+//! samples 0 64           (first, end exclusive)
+//! seed 0
+//! sampler sobol
+//! pixelsampling uniform  (where samples go in a pixel: uniform or stratified)
+//! gamma 3f800000         (the f32 bits of the output encoding's gamma)
+//! data
+//! ```
+//!
+//! — then, for every pixel of the rectangle row by row, its three sums (i128, little
+//! endian: fixed point with 64 fractional bits, [`ExactSum`]) and its sample count (u32),
+//! and last a 64-bit FNV-1a checksum of those bytes. Files are written whole or not at
+//! all (a temporary file renamed), and a file whose checksum does not match is refused.
+
+use std::ops::Range;
+
+use lucent_core::film::{ExactSum, Film};
+use lucent_core::render::job::PixelRect;
+
+/// What a render state holds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderState {
+    pub header: StateHeader,
+    /// The sums and counts of `header.pixels`.
+    pub film: Film,
+}
+
+/// Everything a state file says besides its pixels: what must agree for two states to
+/// merge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StateHeader {
+    pub scene_hash: u64,
+    pub resolution: (u32, u32),
+    pub pixels: PixelRect,
+    pub spp: u32,
+    pub samples: Range<u32>,
+    pub seed: u64,
+    pub sampler: String,
+    /// `uniform` (the Monte Carlo integrators: sample i is the same for any spp) or
+    /// `stratified` (the ray tracer: sample positions depend on spp).
+    pub pixel_sampling: String,
+    pub gamma: f32,
+}
+
+const MAGIC: &str = "lucent-state 1";
+const PIXEL_BYTES: usize = 3 * 16 + 4;
+
+/// FNV-1a, 64 bits.
+pub fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+pub const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
+
+impl RenderState {
+    pub fn encode(&self) -> Vec<u8> {
+        let h = &self.header;
+        let p = h.pixels;
+        let mut out = format!(
+            "{MAGIC}\nscene {:016x}\nresolution {} {}\npixels {} {} {} {}\nspp {}\nsamples {} {}\nseed {}\nsampler {}\npixelsampling {}\ngamma {:08x}\ndata\n",
+            h.scene_hash,
+            h.resolution.0,
+            h.resolution.1,
+            p.x0,
+            p.x1,
+            p.y0,
+            p.y1,
+            h.spp,
+            h.samples.start,
+            h.samples.end,
+            h.seed,
+            h.sampler,
+            h.pixel_sampling,
+            h.gamma.to_bits()
+        )
+        .into_bytes();
+        let start = out.len();
+        out.reserve(self.film.sums.len() * PIXEL_BYTES + 8);
+        for (s, &n) in self.film.sums.iter().zip(&self.film.counts) {
+            for v in s.0 {
+                out.extend(v.to_le_bytes());
+            }
+            out.extend(n.to_le_bytes());
+        }
+        let sum = fnv1a(&out[start..], FNV_START);
+        out.extend(sum.to_le_bytes());
+        out
+    }
+
+    /// Reads a state file's bytes; the error says what is wrong with them.
+    pub fn decode(bytes: &[u8]) -> Result<RenderState, String> {
+        let mut pos = 0;
+        let mut line = || -> Result<&str, String> {
+            let rest = &bytes[pos..];
+            let end = rest
+                .iter()
+                .take(200)
+                .position(|&b| b == b'\n')
+                .ok_or("not a lucent state file (its header is cut short)")?;
+            pos += end + 1;
+            std::str::from_utf8(&rest[..end]).map_err(|_| "not a lucent state file (its header is not text)".to_string())
+        };
+        if line()? != MAGIC {
+            return Err(format!("not a lucent state file (it does not start with '{MAGIC}')"));
+        }
+        let mut field = |key: &str, count: usize| -> Result<Vec<String>, String> {
+            let l = line()?;
+            let mut words = l.split(' ');
+            if words.next() != Some(key) {
+                return Err(format!("the header has '{l}' where '{key}' belongs"));
+            }
+            let values: Vec<String> = words.map(str::to_string).collect();
+            if values.len() != count {
+                return Err(format!("the header's '{key}' has {} values, not {count}", values.len()));
+            }
+            Ok(values)
+        };
+        let num = |s: &str, what: &str| s.parse::<u64>().map_err(|_| format!("the header's {what} '{s}' is not a number"));
+        let small = |s: &str, what: &str| s.parse::<u32>().map_err(|_| format!("the header's {what} '{s}' is not a number"));
+        let scene = field("scene", 1)?;
+        let scene_hash = u64::from_str_radix(&scene[0], 16).map_err(|_| "the header's scene hash is not hexadecimal")?;
+        let r = field("resolution", 2)?;
+        let resolution = (small(&r[0], "width")?, small(&r[1], "height")?);
+        let p = field("pixels", 4)?;
+        let pixels = PixelRect {
+            x0: small(&p[0], "x0")?,
+            x1: small(&p[1], "x1")?,
+            y0: small(&p[2], "y0")?,
+            y1: small(&p[3], "y1")?,
+        };
+        let spp = small(&field("spp", 1)?[0], "spp")?;
+        let s = field("samples", 2)?;
+        let samples = small(&s[0], "first sample")?..small(&s[1], "sample end")?;
+        let seed = num(&field("seed", 1)?[0], "seed")?;
+        let sampler = field("sampler", 1)?.remove(0);
+        let pixel_sampling = field("pixelsampling", 1)?.remove(0);
+        let g = field("gamma", 1)?;
+        let gamma = f32::from_bits(u32::from_str_radix(&g[0], 16).map_err(|_| "the header's gamma is not hexadecimal")?);
+        field("data", 0)?;
+        if !(pixels.x0 < pixels.x1 && pixels.y0 < pixels.y1 && pixels.x1 <= resolution.0 && pixels.y1 <= resolution.1) {
+            return Err("the header's pixels are not a rectangle inside its resolution".into());
+        }
+        if !(samples.start < samples.end && samples.end <= spp) {
+            return Err("the header's samples are not a range within its spp".into());
+        }
+        let n = pixels.pixels() as usize;
+        let data = &bytes[pos..];
+        if data.len() != n * PIXEL_BYTES + 8 {
+            return Err(format!(
+                "{} bytes of pixel data where {} pixels need {} (a file cut short?)",
+                data.len(),
+                n,
+                n * PIXEL_BYTES + 8
+            ));
+        }
+        let (body, check) = data.split_at(n * PIXEL_BYTES);
+        if fnv1a(body, FNV_START).to_le_bytes() != check {
+            return Err("its pixel data does not match its checksum (a damaged file)".into());
+        }
+        let mut film = Film::new(pixels.width(), pixels.height());
+        for (k, px) in body.chunks_exact(PIXEL_BYTES).enumerate() {
+            let i = |j: usize| i128::from_le_bytes(px[16 * j..16 * j + 16].try_into().unwrap());
+            film.sums[k] = ExactSum([i(0), i(1), i(2)]);
+            film.counts[k] = u32::from_le_bytes(px[48..52].try_into().unwrap());
+        }
+        Ok(RenderState {
+            header: StateHeader {
+                scene_hash,
+                resolution,
+                pixels,
+                spp,
+                samples,
+                seed,
+                sampler,
+                pixel_sampling,
+                gamma,
+            },
+            film,
+        })
+    }
+}
+
+fn overlap(a: &PixelRect, b: &PixelRect) -> bool {
+    a.x0 < b.x1 && b.x0 < a.x1 && a.y0 < b.y1 && b.y0 < a.y1
+}
+
+fn describe(h: &StateHeader) -> String {
+    let p = h.pixels;
+    format!(
+        "pixels {}..{} x {}..{}, samples {}..{}",
+        p.x0,
+        p.x1,
+        p.y0,
+        p.y1,
+        h.samples.start,
+        h.samples.end.saturating_sub(1)
+    )
+}
+
+/// Combines states of one render — regions, sample ranges or both — into one: every pixel
+/// of the combined rectangle must be covered by states whose sample ranges do not overlap
+/// and together make one range. `names` name the states in messages.
+pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, String> {
+    let first = states.first().ok_or("nothing to merge")?;
+    let f = &first.header;
+    for (s, name) in states.iter().zip(names).skip(1) {
+        let h = &s.header;
+        let differs = [
+            (h.scene_hash != f.scene_hash, "scene"),
+            (h.resolution != f.resolution, "resolution"),
+            (h.spp != f.spp, "samples per pixel"),
+            (h.seed != f.seed, "seed"),
+            (h.sampler != f.sampler, "sampler"),
+            (h.pixel_sampling != f.pixel_sampling, "integrator's pixel sampling"),
+            (h.gamma.to_bits() != f.gamma.to_bits(), "gamma"),
+        ];
+        if let Some((_, what)) = differs.iter().find(|(d, _)| *d) {
+            return Err(format!("{name} and {} are renders of a different {what}; they cannot be merged", names[0]));
+        }
+    }
+    // Overlaps: two states that share a pixel must share no sample index.
+    for i in 0..states.len() {
+        for j in i + 1..states.len() {
+            let (a, b) = (&states[i].header, &states[j].header);
+            if overlap(&a.pixels, &b.pixels) && a.samples.start < b.samples.end && b.samples.start < a.samples.end {
+                return Err(format!(
+                    "{} ({}) and {} ({}) overlap: both hold some samples of the same pixels",
+                    names[i],
+                    describe(a),
+                    names[j],
+                    describe(b)
+                ));
+            }
+        }
+    }
+    let union = PixelRect {
+        x0: states.iter().map(|s| s.header.pixels.x0).min().unwrap(),
+        x1: states.iter().map(|s| s.header.pixels.x1).max().unwrap(),
+        y0: states.iter().map(|s| s.header.pixels.y0).min().unwrap(),
+        y1: states.iter().map(|s| s.header.pixels.y1).max().unwrap(),
+    };
+    let range = states.iter().map(|s| s.header.samples.start).min().unwrap()
+        ..states.iter().map(|s| s.header.samples.end).max().unwrap();
+    let mut film = Film::new(union.width(), union.height());
+    // How many sample indices cover each pixel: with no overlaps, all of `range` exactly
+    // when it is the range's length.
+    let mut covered = vec![0u32; film.counts.len()];
+    let w = union.width() as usize;
+    for s in states {
+        let p = s.header.pixels;
+        let len = s.header.samples.len() as u32;
+        for y in 0..p.height() {
+            for x in 0..p.width() {
+                let src = (y * p.width() + x) as usize;
+                let dst = (p.y0 - union.y0 + y) as usize * w + (p.x0 - union.x0 + x) as usize;
+                film.add(dst, &s.film.sums[src], s.film.counts[src]);
+                covered[dst] += len;
+            }
+        }
+    }
+    if let Some(k) = covered.iter().position(|&c| c != range.len() as u32) {
+        let (x, y) = (union.x0 + (k % w) as u32, union.y0 + (k / w) as u32);
+        return Err(format!(
+            "a gap: pixel ({x}, {y}) has {} of the samples {}..{} that the inputs hold together",
+            covered[k],
+            range.start,
+            range.end - 1
+        ));
+    }
+    Ok(RenderState {
+        header: StateHeader {
+            pixels: union,
+            samples: range,
+            ..f.clone()
+        },
+        film,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lucent_core::math::Color;
+
+    fn state(pixels: PixelRect, samples: Range<u32>) -> RenderState {
+        let mut film = Film::new(pixels.width(), pixels.height());
+        for (k, s) in film.sums.iter_mut().enumerate() {
+            for i in samples.clone() {
+                s.add_sample(Color::splat((k as f32 + 1.0) * 0.1 + i as f32 * 0.01));
+            }
+        }
+        film.counts.iter_mut().for_each(|c| *c = samples.len() as u32);
+        RenderState {
+            header: StateHeader {
+                scene_hash: 0xabc,
+                resolution: (8, 4),
+                pixels,
+                spp: 16,
+                samples,
+                seed: 3,
+                sampler: "sobol".into(),
+                pixel_sampling: "uniform".into(),
+                gamma: 2.2,
+            },
+            film,
+        }
+    }
+
+    fn rect(x0: u32, x1: u32, y0: u32, y1: u32) -> PixelRect {
+        PixelRect { x0, x1, y0, y1 }
+    }
+
+    #[test]
+    fn states_survive_a_round_trip_and_refuse_damage() {
+        let s = state(rect(1, 5, 0, 3), 2..9);
+        let bytes = s.encode();
+        assert_eq!(RenderState::decode(&bytes).unwrap(), s);
+        let mut bad = bytes.clone();
+        let n = bad.len();
+        bad[n - 20] ^= 1;
+        assert!(RenderState::decode(&bad).unwrap_err().contains("checksum"));
+        assert!(RenderState::decode(&bytes[..n - 1]).unwrap_err().contains("cut short"));
+        assert!(RenderState::decode(b"P6\n").unwrap_err().contains("not a lucent state file"));
+    }
+
+    #[test]
+    fn merging_checks_overlaps_gaps_and_origins() {
+        let names: Vec<String> = (0..4).map(|i| format!("s{i}")).collect();
+        // Two halves of the sample range over the left half, one range over the right.
+        let parts = [state(rect(0, 4, 0, 4), 0..8), state(rect(0, 4, 0, 4), 8..16), state(rect(4, 8, 0, 4), 0..16)];
+        let m = merge(&parts, &names).unwrap();
+        assert_eq!((m.header.pixels, m.header.samples.clone()), (rect(0, 8, 0, 4), 0..16));
+        assert!(m.film.counts.iter().all(|&c| c == 16));
+        // Overlap.
+        let e = merge(&[state(rect(0, 4, 0, 4), 0..8), state(rect(2, 6, 0, 4), 4..12)], &names).unwrap_err();
+        assert!(e.contains("overlap"), "{e}");
+        // Gap in the samples of some pixels, and a hole in the rectangle.
+        let e = merge(&[state(rect(0, 4, 0, 4), 0..16), state(rect(4, 8, 0, 4), 0..8)], &names).unwrap_err();
+        assert!(e.contains("gap: pixel (4, 0)"), "{e}");
+        let e = merge(&[state(rect(0, 2, 0, 4), 0..16), state(rect(4, 8, 0, 4), 0..16)], &names).unwrap_err();
+        assert!(e.contains("gap: pixel (2, 0)"), "{e}");
+        // Another scene.
+        let mut other = state(rect(4, 8, 0, 4), 0..16);
+        other.header.scene_hash = 1;
+        let e = merge(&[state(rect(0, 4, 0, 4), 0..16), other], &names).unwrap_err();
+        assert!(e.contains("different scene"), "{e}");
+    }
+}

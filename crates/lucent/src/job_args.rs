@@ -1,0 +1,96 @@
+//! The part of a render the command line picks: `--crop x0 x1 y0 y1` (fractions of the
+//! image, pbrt's cropwindow), `--pixel-bounds x0 x1 y0 y1` (pixels, ends exclusive),
+//! `--samples FIRST..LAST` (inclusive, like Blender's frame ranges) and `--seed N`.
+
+use lucent_core::render::job::{PixelRect, RenderJob};
+
+/// `--samples FIRST..LAST`: the inclusive range as `FIRST..LAST+1`.
+pub fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or_else(|| format!("'{s}' is not a range FIRST..LAST (e.g. 0..63: the first 64 samples)"))?;
+    let num = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("'{v}' in '{s}' is not a sample index (a whole number ≥ 0)"))
+    };
+    let (a, b) = (num(a)?, num(b)?);
+    if b < a {
+        return Err(format!("'{s}' ends before it starts"));
+    }
+    b.checked_add(1)
+        .map(|end| a..end)
+        .ok_or_else(|| format!("'{s}' goes past the largest sample index"))
+}
+
+/// The pixels of `--crop` (pbrt's rule: the fractions times the resolution, rounded up)
+/// or `--pixel-bounds` within a `width × height` image.
+pub fn pixel_rect(crop: Option<&[f64]>, bounds: Option<&[u32]>, width: u32, height: u32) -> Result<Option<PixelRect>, String> {
+    let rect = match (crop, bounds) {
+        (Some(c), _) => {
+            if let Some(v) = c.iter().find(|v| !(0.0..=1.0).contains(*v)) {
+                return Err(format!("--crop: {v} is not a fraction between 0 and 1"));
+            }
+            let at = |f: f64, n: u32| (f * n as f64).ceil() as u32;
+            PixelRect {
+                x0: at(c[0], width),
+                x1: at(c[1], width),
+                y0: at(c[2], height),
+                y1: at(c[3], height),
+            }
+        }
+        (None, Some(b)) => PixelRect {
+            x0: b[0],
+            x1: b[1],
+            y0: b[2],
+            y1: b[3],
+        },
+        (None, None) => return Ok(None),
+    };
+    let what = if crop.is_some() { "--crop" } else { "--pixel-bounds" };
+    if !(rect.x0 < rect.x1 && rect.y0 < rect.y1 && rect.x1 <= width && rect.y1 <= height) {
+        return Err(format!(
+            "{what}: pixels {}..{} x {}..{} are not a non-empty rectangle inside the {width} x {height} image",
+            rect.x0, rect.x1, rect.y0, rect.y1
+        ));
+    }
+    Ok(Some(rect))
+}
+
+/// Applies `--samples` to the job: the range must lie within `0..spp`.
+pub fn apply_samples(job: &mut RenderJob, samples: &std::ops::Range<u32>) -> Result<(), String> {
+    if samples.end > job.spp {
+        return Err(format!(
+            "--samples {}..{}: the render has {} samples per pixel (indices 0..{})",
+            samples.start,
+            samples.end - 1,
+            job.spp,
+            job.spp - 1
+        ));
+    }
+    job.samples = samples.clone();
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sample_ranges_are_inclusive_and_checked() {
+        assert_eq!(parse_samples("0..63"), Ok(0..64));
+        assert_eq!(parse_samples("64..64"), Ok(64..65));
+        assert!(parse_samples("5..2").unwrap_err().contains("ends before"));
+        assert!(parse_samples("a..2").unwrap_err().contains("not a sample index"));
+        assert!(parse_samples("7").unwrap_err().contains("not a range"));
+    }
+
+    #[test]
+    fn crops_round_up_as_pbrt_does() {
+        let r = pixel_rect(Some(&[0.0, 0.5, 0.25, 1.0]), None, 101, 10).unwrap().unwrap();
+        assert_eq!((r.x0, r.x1, r.y0, r.y1), (0, 51, 3, 10));
+        assert!(pixel_rect(Some(&[0.5, 0.5, 0.0, 1.0]), None, 10, 10).is_err());
+        assert!(pixel_rect(None, Some(&[0, 11, 0, 1]), 10, 10).is_err());
+        assert_eq!(pixel_rect(None, None, 10, 10), Ok(None));
+    }
+}

@@ -1,0 +1,139 @@
+//! Regions, sample ranges, state files, `lucent merge` and `--resume`, end to end: a
+//! render put together from parts is the bytes of the render made in one go (PNG and
+//! EXR), for every integrator and any thread count; inputs that do not belong together
+//! are refused with a message that names them.
+
+use std::fs;
+use std::path::Path;
+use std::process::{Command, Output};
+
+mod common;
+
+fn workdir(name: &str) -> common::WorkDir {
+    common::workdir("long", name)
+}
+
+fn lucent(dir: &Path, args: &[&str]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run lucent");
+    o
+}
+
+fn ok(dir: &Path, args: &[&str]) {
+    let o = lucent(dir, args);
+    assert!(o.status.success(), "lucent {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+}
+
+fn fails(dir: &Path, args: &[&str], says: &str) {
+    let o = lucent(dir, args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "lucent {args:?}: {err}");
+    assert!(err.contains(says), "lucent {args:?}: expected «{says}» in {err}");
+}
+
+/// A small scene with glass, a sphere, a floor and a quad light, in `integrator`.
+fn scene(integrator: &str) -> String {
+    format!(
+        "size 40 30\n{integrator}\ngamma 2.2\ncamera 0 1 3 0 0.8 0 0 1 0 45\nambient 0.02 0.02 0.02\n\
+         quadLight -0.25 1.999 -0.25 0 0 0.5  0.5 0 0  30 26 21\ndiffuse 0.7 0.7 0.7\nspecular 0.2 0.2 0.2\n\
+         maxverts 4\nvertex -2 0 -2\nvertex 2 0 -2\nvertex 2 0 2\nvertex -2 0 2\ntri 0 2 1\ntri 0 3 2\n\
+         diffuse 0.2 0.6 0.3\nsphere 0 0.5 0 0.4\ntransparent 1 1 1\nior 1.5\ndiffuse 0 0 0\nspecular 0 0 0\n\
+         sphere 0.5 0.3 0.4 0.25\n"
+    )
+}
+
+const INTEGRATORS: [&str; 3] = [
+    "spp 16\nmaxdepth 3",
+    "integrator direct\nspp 12\nlightsamples 4",
+    "integrator pathtracer\nspp 16\nnexteventestimation mis\nimportancesampling brdf\nrussianroulette on\nmaxdepth -1",
+];
+
+#[test]
+fn regions_and_sample_ranges_merge_into_the_bytes_of_the_one_go_render() {
+    let dir = workdir("merge");
+    for (k, integrator) in INTEGRATORS.iter().enumerate() {
+        fs::write(dir.join("s.test"), scene(integrator)).unwrap();
+        ok(&dir, &["render", "s.test", "-o", "one.png", "-q", "--threads", "2"]);
+        ok(&dir, &["render", "s.test", "-o", "one.exr", "-q", "--threads", "1"]);
+        // Four parts: the top rows in two sample ranges (one with one thread, one with
+        // two), the bottom left and bottom right by fractions; the last range is
+        // whatever the scene's spp leaves.
+        let spp = if k == 1 { 12 } else { 16 };
+        let last = format!("5..{}", spp - 1);
+        let parts: [&[&str]; 4] = [
+            &["--pixel-bounds", "0", "40", "0", "11", "--samples", "0..4", "--threads", "1"],
+            &["--pixel-bounds", "0", "40", "0", "11", "--samples", &last, "--threads", "2"],
+            &["--crop", "0", "0.5", "0.35", "1"],
+            &["--crop", "0.5", "1", "0.35", "1"],
+        ];
+        let mut states = Vec::new();
+        for (i, extra) in parts.iter().enumerate() {
+            let state = format!("p{i}.lstate");
+            let mut args = vec!["render", "s.test", "-o", "part.png", "-q", "--state", &state];
+            args.extend_from_slice(extra);
+            ok(&dir, &args);
+            states.push(state);
+        }
+        let mut args: Vec<&str> = vec!["merge"];
+        args.extend(states.iter().map(String::as_str));
+        ok(&dir, &[&args[..], &["-o", "m.png", "--state", "m.lstate"]].concat());
+        ok(&dir, &["merge", "m.lstate", "-o", "m.exr"]);
+        assert!(fs::read(dir.join("one.png")).unwrap() == fs::read(dir.join("m.png")).unwrap(), "{integrator:?}: PNG");
+        assert!(fs::read(dir.join("one.exr")).unwrap() == fs::read(dir.join("m.exr")).unwrap(), "{integrator:?}: EXR");
+        // A region's own image is the region: 20 × 20 pixels here (rows 11..30 of 30).
+        let part = image::open(dir.join("part.png")).unwrap();
+        assert_eq!((part.width(), part.height()), (20, 19), "{integrator:?}");
+    }
+}
+
+#[test]
+fn a_resumed_render_is_the_render_made_in_one_go() {
+    let dir = workdir("resume");
+    fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
+    ok(&dir, &["render", "s.test", "-o", "one.exr", "-q", "--spp", "24"]);
+    ok(&dir, &["render", "s.test", "-o", "a.exr", "-q", "--spp", "8", "--state", "a.lstate"]);
+    ok(&dir, &["render", "s.test", "-o", "b.exr", "-q", "--resume", "a.lstate", "--spp", "16", "--state", "b.lstate"]);
+    ok(&dir, &["render", "s.test", "-o", "c.exr", "-q", "--resume", "b.lstate", "--spp", "24"]);
+    assert!(fs::read(dir.join("one.exr")).unwrap() == fs::read(dir.join("c.exr")).unwrap());
+    fails(&dir, &["render", "s.test", "-o", "d.exr", "--resume", "b.lstate", "--spp", "16"], "already holds samples 0..15");
+    // The ray tracer's samples sit on a grid of spp cells: it cannot be continued.
+    fs::write(dir.join("w.test"), scene(INTEGRATORS[0])).unwrap();
+    ok(&dir, &["render", "w.test", "-o", "w.png", "-q", "--state", "w.lstate"]);
+    fails(&dir, &["render", "w.test", "-o", "x.png", "--resume", "w.lstate", "--spp", "32"], "only renders of the Monte Carlo integrators");
+    // Another scene text, another seed.
+    fs::write(dir.join("t.test"), scene(INTEGRATORS[2]).replace("0.7 0.7 0.7", "0.6 0.7 0.7")).unwrap();
+    fails(&dir, &["render", "t.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16"], "the scene's text has changed");
+    fails(&dir, &["render", "s.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16", "--seed", "5"], "the seed differs");
+}
+
+#[test]
+fn merging_refuses_other_scenes_overlaps_gaps_and_damaged_files() {
+    let dir = workdir("refuse");
+    fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
+    fs::write(dir.join("t.test"), scene(INTEGRATORS[2]).replace("size 40 30", "size 40 30\nmaxdepth 4")).unwrap();
+    let half = |name: &str, scene: &str, y0: &str, y1: &str| {
+        ok(&dir, &["render", scene, "-o", "x.png", "-q", "--pixel-bounds", "0", "40", y0, y1, "--state", name]);
+    };
+    half("top.lstate", "s.test", "0", "15");
+    half("bottom.lstate", "s.test", "15", "30");
+    half("other.lstate", "t.test", "15", "30");
+    half("big.lstate", "s.test", "10", "30");
+    fails(&dir, &["merge", "top.lstate", "other.lstate", "-o", "m.png"], "other.lstate and top.lstate are renders of a different scene");
+    fails(&dir, &["merge", "top.lstate", "big.lstate", "-o", "m.png"], "overlap");
+    ok(&dir, &["render", "s.test", "-o", "x.png", "-q", "--pixel-bounds", "0", "40", "15", "30", "--samples", "0..7", "--state", "few.lstate"]);
+    fails(&dir, &["merge", "top.lstate", "few.lstate", "-o", "m.png"], "a gap: pixel (0, 15) has 8 of the samples 0..15");
+    let mut bytes = fs::read(dir.join("bottom.lstate")).unwrap();
+    let n = bytes.len();
+    bytes[n - 100] ^= 0x40;
+    fs::write(dir.join("bad.lstate"), &bytes).unwrap();
+    fails(&dir, &["merge", "top.lstate", "bad.lstate", "-o", "m.png"], "bad.lstate: its pixel data does not match its checksum");
+    assert!(!dir.join("m.png").exists(), "a refused merge writes nothing");
+    ok(&dir, &["merge", "top.lstate", "bottom.lstate", "-o", "m.png"]);
+    // Bad options are located errors too.
+    fails(&dir, &["render", "s.test", "-o", "x.png", "--samples", "0..99"], "--samples 0..99: the render has 16 samples per pixel");
+    fails(&dir, &["render", "s.test", "-o", "x.png", "--crop", "0.5", "0.2", "0", "1"], "--crop: pixels 20..8");
+    fails(&dir, &["render", "s.test", "-o", "x.png", "--noise-threshold", "0.1", "--samples", "0..3"], "adaptive sampling");
+}
