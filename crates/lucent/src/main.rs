@@ -9,6 +9,7 @@ mod job_args;
 mod merge;
 mod oom;
 mod output;
+mod passes;
 mod progress;
 mod render;
 mod signals;

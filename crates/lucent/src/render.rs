@@ -24,6 +24,8 @@ use lucent_io::state::{RenderState, StateHeader};
 use crate::output::{choose_output, report};
 use crate::progress::Progress;
 use crate::job_args::{apply_samples, parse_samples, pixel_rect};
+use crate::output::Output;
+use crate::passes::{render_in_passes, Outcome};
 use crate::signals;
 use crate::EXIT_BAD_INPUT;
 
@@ -78,6 +80,11 @@ pub struct RenderArgs {
     /// samples per pixel: the same pixels, the sample indices after its last.
     #[arg(long, value_name = "STATE", conflicts_with_all = ["crop", "pixel_bounds", "samples"])]
     pub resume: Option<PathBuf>,
+    /// Every SECS seconds, write the image of the samples done so far and a state to
+    /// resume from (OUT.partial.png and OUT.partial.lstate, or --state), each whole or
+    /// not at all; they are removed when the render completes.
+    #[arg(long, value_name = "SECS", value_parser = parse_seconds)]
+    pub checkpoint: Option<f64>,
     /// Acceleration structure.
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
@@ -100,6 +107,14 @@ fn parse_threshold(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(t) if t >= 0.0 && t.is_finite() => Ok(t),
         _ => Err(format!("'{s}' is not a number >= 0")),
+    }
+}
+
+/// `--checkpoint`: seconds, a finite number > 0.
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a number of seconds > 0")),
     }
 }
 
@@ -254,21 +269,71 @@ pub fn run(args: &RenderArgs) -> u8 {
     let progress = Progress::new(job.pixels.pixels() * job.samples.len() as u64, args.quiet);
     let cancel = signals::cancel_flag();
     let t_render = Instant::now();
-    let rendered = renderer.render(built, &job, &|n| progress.advance(n), cancel);
+    // Partial results (a checkpoint, or what an interrupt leaves) go beside the output,
+    // never over it: OUT.partial.png and, without --state, OUT.partial.lstate.
+    let partial = Partial::beside(&out, &args.state, &session.desc);
+    let first = resumed.as_ref().map_or(job.samples.start, |s| s.header.samples.start);
+    let mut wrote_partial = false;
+    let mut save = |film: &Film, samples: &std::ops::Range<u32>| {
+        let kept = StateHeader {
+            samples: samples.clone(),
+            ..header(&job)
+        };
+        match partial.write(film, kept) {
+            Ok(()) => wrote_partial = true,
+            Err(e) => eprintln!("lucent: warning: checkpoint not written: {e}"),
+        }
+    };
+    let checkpoint = args.checkpoint.map(std::time::Duration::from_secs_f64);
+    let outcome = render_in_passes(
+        &renderer,
+        built,
+        &job,
+        resumed.map(|s| s.film),
+        first,
+        &|n| progress.advance(n),
+        cancel,
+        checkpoint,
+        &mut save,
+    );
     let t_rendered = Instant::now();
     progress.finish();
-    let Some((mut film, stats)) = rendered.filter(|_| !cancel.load(Ordering::Relaxed)) else {
-        eprintln!("lucent: interrupted; nothing written");
-        return signals::exit_code();
+    let (film, stats) = match outcome {
+        Outcome::Done(film, stats) if !cancel.load(Ordering::Relaxed) => (film, stats),
+        Outcome::Interrupted(Some((film, samples))) => {
+            signals::saving(true);
+            let kept = StateHeader {
+                samples: samples.clone(),
+                ..header(&job)
+            };
+            let how = if pixel_sampling == "uniform" {
+                format!("continue with: lucent render {} --resume {}", args.scene.display(), partial.state_name())
+            } else {
+                format!(
+                    "render the rest with --samples {}..{} --state REST.lstate and put them together with lucent merge",
+                    samples.end,
+                    job.spp - 1
+                )
+            };
+            match partial.write(&film, kept) {
+                Ok(()) => eprintln!(
+                    "lucent: interrupted after samples {}..{} of every pixel: wrote {} and {}; {how}",
+                    samples.start,
+                    samples.end - 1,
+                    partial.image_name(),
+                    partial.state_name()
+                ),
+                Err(e) => eprintln!("lucent: interrupted; the partial render was not written: {e}"),
+            }
+            return signals::exit_code();
+        }
+        _ => {
+            eprintln!("lucent: interrupted; nothing written");
+            return signals::exit_code();
+        }
     };
     let mut kept = header(&job);
-    if let Some(earlier) = resumed {
-        // The earlier samples' sums come first: exact sums make the order irrelevant.
-        kept.samples = earlier.header.samples.start..job.samples.end;
-        let mut total = earlier.film;
-        add_film(&mut total, &film);
-        film = total;
-    }
+    kept.samples = first..job.samples.end;
 
     if stats.bad_samples > 0 {
         eprintln!(
@@ -315,6 +380,9 @@ pub fn run(args: &RenderArgs) -> u8 {
             eprintln!("lucent: error: cannot write {}: {e}", name.display());
             return EXIT_BAD_INPUT;
         }
+    }
+    if wrote_partial {
+        partial.remove();
     }
     let t_written = Instant::now();
 
@@ -390,13 +458,6 @@ fn resume(path: &std::path::Path, job: &mut RenderJob, now: &StateHeader) -> Res
     Ok(state)
 }
 
-/// Adds `more`'s sums and counts to `film` (the same pixels).
-fn add_film(film: &mut Film, more: &Film) {
-    for (i, (s, &n)) in more.sums.iter().zip(&more.counts).enumerate() {
-        film.add(i, s, n);
-    }
-}
-
 /// Worker threads for `--threads N` (all cores without it), or the exit code after
 /// saying why they could not start.
 pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
@@ -404,4 +465,64 @@ pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
         eprintln!("lucent: error: {e}");
         1
     })
+}
+
+/// Where a partial render goes: `OUT.partial.EXT` beside the output (nothing for standard
+/// output or a device) and the state at `--state`, else `OUT.partial.lstate`.
+struct Partial {
+    image: Option<Output>,
+    state: (PathBuf, bool),
+}
+
+impl Partial {
+    fn beside(out: &Output, state: &Option<PathBuf>, desc: &lucent_io::desc::SceneDesc) -> Partial {
+        let is_file = matches!(out.target, OutputTarget::File(_));
+        let with = |ext: &str| {
+            let stem = out.name.file_stem().map_or("render".into(), |s| s.to_string_lossy().into_owned());
+            out.name.with_file_name(format!("{stem}.partial.{ext}"))
+        };
+        let ext = out.name.extension().map_or("png".into(), |e| e.to_string_lossy().into_owned());
+        let mut quiet = lucent_io::diag::Diagnostics::default();
+        let image = is_file
+            .then(|| crate::output::choose_output(Some(&with(&ext)), desc, &mut quiet).ok())
+            .flatten();
+        let state = match state {
+            Some(p) => (p.clone(), false),
+            None => (with("lstate"), true),
+        };
+        Partial { image, state }
+    }
+
+    fn image_name(&self) -> String {
+        self.image.as_ref().map_or("no image".into(), |o| o.name.display().to_string())
+    }
+
+    fn state_name(&self) -> String {
+        self.state.0.display().to_string()
+    }
+
+    /// Writes the partial image and the state (each atomically).
+    fn write(&self, film: &Film, header: StateHeader) -> Result<(), String> {
+        if let Some(img) = &self.image {
+            crate::output::write_image(img, &film.resolve(), header.gamma)?;
+        }
+        let state = RenderState {
+            header,
+            film: film.clone(),
+        };
+        OutputTarget::resolve(&self.state.0)
+            .and_then(|t| t.write(&state.encode()))
+            .map_err(|e| format!("cannot write {}: {e}", self.state.0.display()))
+    }
+
+    /// Removes what checkpoints wrote, once the render is complete (the state at
+    /// `--state` is the final one by then, and stays).
+    fn remove(&self) {
+        if let Some(img) = &self.image {
+            let _ = std::fs::remove_file(&img.name);
+        }
+        if self.state.1 {
+            let _ = std::fs::remove_file(&self.state.0);
+        }
+    }
 }

@@ -1,9 +1,11 @@
 //! Ctrl-C and SIGTERM. The first asks the render to stop: the render loop looks at the
-//! flag between pixels and between samples, and the run ends with exit code 130 (143 for
-//! SIGTERM) without writing an image; should a single sample take longer, the run ends
-//! anyway a second later. During the write of an output, and at a second signal, the run
-//! ends at once. Every way out removes the temporary file of an output being written, so
-//! an existing output is left as it was.
+//! flag between pixels and between samples, the run saves the samples of the passes it
+//! finished (a partial image and a state beside the output, never over it) and ends with
+//! exit code 130 (143 for SIGTERM); should a single sample take longer, the run ends
+//! anyway a second later (or once the partial render is saved, at most 30 s). During the
+//! write of the final output, and at a second signal, the run ends at once. Every way
+//! out removes the temporary file of an output being written, so an existing output is
+//! left as it was.
 
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::time::Duration;
@@ -13,6 +15,13 @@ use signal_hook::consts::{SIGINT, SIGTERM};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 static SIGNAL: AtomicI32 = AtomicI32::new(0);
+static SAVING: AtomicBool = AtomicBool::new(false);
+
+/// Whether the run is saving a partial render after a signal (the one-second limit then
+/// waits for it, up to 30 s).
+pub fn saving(on: bool) {
+    SAVING.store(on, Ordering::Relaxed);
+}
 
 /// Set once a signal has asked the run to stop.
 pub fn cancel_flag() -> &'static AtomicBool {
@@ -36,10 +45,19 @@ pub fn install() {
             if count > 0 || writing() {
                 stop_now();
             }
-            // The run stops cleanly within a second, or it is stopped.
+            // The run stops cleanly within a second (or once its partial render is
+            // saved), or it is stopped.
             std::thread::spawn(|| {
-                std::thread::sleep(Duration::from_secs(1));
-                stop_now();
+                let start = std::time::Instant::now();
+                loop {
+                    std::thread::sleep(Duration::from_millis(50));
+                    let waited = start.elapsed();
+                    if (waited >= Duration::from_secs(1) && !SAVING.load(Ordering::Relaxed))
+                        || waited >= Duration::from_secs(30)
+                    {
+                        stop_now();
+                    }
+                }
             });
         }
     });

@@ -59,11 +59,12 @@ const CLI: Floors = &[
     ("signals", 0),
     ("oom", 0),
     ("job_args", 0),
-    ("render", 1),
-    ("check", 1),
-    ("diff", 1),
-    ("merge", 1),
-    ("bench", 1),
+    ("passes", 1),
+    ("render", 2),
+    ("check", 2),
+    ("diff", 2),
+    ("merge", 2),
+    ("bench", 2),
 ];
 
 /// Modules of `lucent-io` that record what a file says: of `lucent-core` they may use

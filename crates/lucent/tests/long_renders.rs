@@ -137,3 +137,52 @@ fn merging_refuses_other_scenes_overlaps_gaps_and_damaged_files() {
     fails(&dir, &["render", "s.test", "-o", "x.png", "--crop", "0.5", "0.2", "0", "1"], "--crop: pixels 20..8");
     fails(&dir, &["render", "s.test", "-o", "x.png", "--noise-threshold", "0.1", "--samples", "0..3"], "adaptive sampling");
 }
+
+#[test]
+fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
+    use std::time::{Duration, Instant};
+    let dir = workdir("interrupt");
+    // Far more samples than the test waits for; an earlier final image must survive.
+    let text = scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000");
+    fs::write(dir.join("s.test"), &text).unwrap();
+    fs::write(dir.join("out.exr"), b"an earlier render").unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render", "s.test", "-o", "out.exr", "-q", "--checkpoint", "0.5"])
+        .current_dir(&dir)
+        .spawn()
+        .unwrap();
+    // A checkpoint appears while the render runs.
+    let start = Instant::now();
+    while !dir.join("out.partial.lstate").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    std::thread::sleep(Duration::from_millis(700));
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let stopped = Instant::now();
+    let out = child.wait_with_output().unwrap();
+    assert!(stopped.elapsed() < Duration::from_secs(3), "took {:?}", stopped.elapsed());
+    assert_eq!(out.status.code(), Some(130));
+    assert_eq!(fs::read(dir.join("out.exr")).unwrap(), b"an earlier render", "the final output is never replaced by a partial one");
+    let state = lucent_io::state::RenderState::decode(&fs::read(dir.join("out.partial.lstate")).unwrap()).unwrap();
+    let done = state.header.samples.clone();
+    assert!(done.start == 0 && done.end >= 2, "{done:?}");
+    assert!(dir.join("out.partial.exr").exists());
+    // Resumed to a few more samples, it is the one-go render of that many.
+    let spp = (done.end + 3).to_string();
+    ok(&dir, &["render", "s.test", "-o", "resumed.exr", "-q", "--resume", "out.partial.lstate", "--spp", &spp]);
+    ok(&dir, &["render", "s.test", "-o", "one.exr", "-q", "--spp", &spp]);
+    assert!(fs::read(dir.join("resumed.exr")).unwrap() == fs::read(dir.join("one.exr")).unwrap());
+}
+
+#[test]
+fn checkpoints_are_removed_when_the_render_completes() {
+    let dir = workdir("checkpoint");
+    fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
+    ok(&dir, &["render", "s.test", "-o", "a.png", "-q", "--checkpoint", "0.001", "--state", "a.lstate"]);
+    ok(&dir, &["render", "s.test", "-o", "b.png", "-q"]);
+    assert!(fs::read(dir.join("a.png")).unwrap() == fs::read(dir.join("b.png")).unwrap());
+    let names = common::files_in(&dir);
+    assert_eq!(names, ["a.lstate", "a.png", "b.png", "s.test"], "no partial files are left");
+}

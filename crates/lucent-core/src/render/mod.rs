@@ -50,7 +50,7 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
-    fn add(&mut self, other: &RenderStats) {
+    pub fn add(&mut self, other: &RenderStats) {
         self.rays += other.rays;
         self.bad_samples += other.bad_samples;
         self.cut_branches += other.cut_branches;
