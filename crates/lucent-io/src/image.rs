@@ -9,12 +9,47 @@ use image::ImageEncoder;
 use crate::resources::{input::MAX_IMAGE_BYTES, read_input, Inputs};
 
 /// Encodes 8-bit RGB (interleaved, top row first) as PNG.
-pub fn encode_png(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, String> {
+pub fn encode_png(width: u32, height: u32, rgb: &[u8], info: &ImageInfo) -> Result<Vec<u8>, String> {
     let mut png = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut png)
+    {
+        let mut enc = png::Encoder::new(&mut png, width, height);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        // What the bytes mean: the encoding exponent 1/g of SCENE_FORMAT.md §4.1 (1 for
+        // linear values), with the sRGB / Rec. 709 primaries and white point.
+        enc.set_source_gamma(png::ScaledFloat::from_scaled((100_000.0 / info.gamma as f64).round() as u32));
+        enc.set_source_chromaticities(png::SourceChromaticities::new(
+            (0.3127, 0.3290),
+            (0.64, 0.33),
+            (0.30, 0.60),
+            (0.15, 0.06),
+        ));
+        for (k, v) in &info.text {
+            enc.add_text_chunk(k.clone(), v.clone()).map_err(|e| e.to_string())?;
+        }
+        let mut w = enc.write_header().map_err(|e| e.to_string())?;
+        w.write_image_data(rgb).map_err(|e| e.to_string())?;
+        w.finish().map_err(|e| e.to_string())?;
+    }
+    Ok(png)
+}
+
+/// What an image file says about itself besides its pixels: the gamma its 8-bit values
+/// are encoded with (1: linear) and text (PNG tEXt chunks: `Software`, `Source`,
+/// `Comment`…).
+#[derive(Clone, Debug)]
+pub struct ImageInfo {
+    pub gamma: f32,
+    pub text: Vec<(String, String)>,
+}
+
+/// Encodes 8-bit RGB as a JPEG (quality 95).
+pub fn encode_jpeg(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    image::codecs::jpeg::JpegEncoder::new_with_quality(&mut out, 95)
         .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
         .map_err(|e| e.to_string())?;
-    Ok(png)
+    Ok(out)
 }
 
 /// Encodes linear RGB floats (interleaved, top row first) as an OpenEXR file (32-bit float

@@ -8,6 +8,7 @@
 //! ```text
 //! lucent-state 1
 //! scene 9f3a…            (a 64-bit hash of the scene's text, every file of it)
+//! name scene.test        (the scene file's name, for people: not compared)
 //! resolution 640 480
 //! pixels 0 640 0 240     (x0 x1 y0 y1, ends exclusive)
 //! spp 256
@@ -42,6 +43,8 @@ pub struct RenderState {
 #[derive(Clone, Debug, PartialEq)]
 pub struct StateHeader {
     pub scene_hash: u64,
+    /// The scene file's name (without its folder), for people; merging ignores it.
+    pub scene_name: String,
     pub resolution: (u32, u32),
     pub pixels: PixelRect,
     pub spp: u32,
@@ -72,8 +75,9 @@ impl RenderState {
         let h = &self.header;
         let p = h.pixels;
         let mut out = format!(
-            "{MAGIC}\nscene {:016x}\nresolution {} {}\npixels {} {} {} {}\nspp {}\nsamples {} {}\nseed {}\nsampler {}\npixelsampling {}\ngamma {:08x}\ndata\n",
+            "{MAGIC}\nscene {:016x}\nname {}\nresolution {} {}\npixels {} {} {} {}\nspp {}\nsamples {} {}\nseed {}\nsampler {}\npixelsampling {}\ngamma {:08x}\ndata\n",
             h.scene_hash,
+            h.scene_name.replace('\n', " "),
             h.resolution.0,
             h.resolution.1,
             p.x0,
@@ -118,8 +122,15 @@ impl RenderState {
         if line()? != MAGIC {
             return Err(format!("not a lucent state file (it does not start with '{MAGIC}')"));
         }
+        // `count` values after the key; `usize::MAX`: the rest of the line as one value.
         let mut field = |key: &str, count: usize| -> Result<Vec<String>, String> {
             let l = line()?;
+            if count == usize::MAX {
+                let rest = l.strip_prefix(key).and_then(|r| r.strip_prefix(' '));
+                return rest
+                    .map(|r| vec![r.to_string()])
+                    .ok_or_else(|| format!("the header has '{l}' where '{key}' belongs"));
+            }
             let mut words = l.split(' ');
             if words.next() != Some(key) {
                 return Err(format!("the header has '{l}' where '{key}' belongs"));
@@ -134,6 +145,7 @@ impl RenderState {
         let small = |s: &str, what: &str| s.parse::<u32>().map_err(|_| format!("the header's {what} '{s}' is not a number"));
         let scene = field("scene", 1)?;
         let scene_hash = u64::from_str_radix(&scene[0], 16).map_err(|_| "the header's scene hash is not hexadecimal")?;
+        let scene_name = field("name", usize::MAX)?.remove(0);
         let r = field("resolution", 2)?;
         let resolution = (small(&r[0], "width")?, small(&r[1], "height")?);
         let p = field("pixels", 4)?;
@@ -181,6 +193,7 @@ impl RenderState {
         Ok(RenderState {
             header: StateHeader {
                 scene_hash,
+                scene_name,
                 resolution,
                 pixels,
                 spp,
@@ -215,6 +228,30 @@ fn describe(h: &StateHeader) -> String {
 /// Combines states of one render — regions, sample ranges or both — into one: every pixel
 /// of the combined rectangle must be covered by states whose sample ranges do not overlap
 /// and together make one range. `names` name the states in messages.
+/// What an image made from this state says about itself (PNG text): the scene (its name
+/// and hash) and everything that decides its pixels — the same for a render made in one
+/// go and one merged from parts, and it records where a region belongs.
+pub fn describe_render(h: &StateHeader) -> String {
+    let p = h.pixels;
+    format!(
+        "scene {} (hash {:016x}), {} x {} image, pixels {}..{} x {}..{}, samples {}..{} of {} per pixel, seed {}, sampler {}, gamma {}",
+        h.scene_name,
+        h.scene_hash,
+        h.resolution.0,
+        h.resolution.1,
+        p.x0,
+        p.x1,
+        p.y0,
+        p.y1,
+        h.samples.start,
+        h.samples.end.saturating_sub(1),
+        h.spp,
+        h.seed,
+        h.sampler,
+        h.gamma
+    )
+}
+
 pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, String> {
     let first = states.first().ok_or("nothing to merge")?;
     let f = &first.header;
@@ -308,6 +345,7 @@ mod tests {
         RenderState {
             header: StateHeader {
                 scene_hash: 0xabc,
+                scene_name: "a scene.test".into(),
                 resolution: (8, 4),
                 pixels,
                 spp: 16,

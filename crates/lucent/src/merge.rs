@@ -54,7 +54,8 @@ pub fn run(args: &MergeArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
-    if let Err(e) = write_image(&out, &merged.film.resolve(), merged.header.gamma) {
+    let text = crate::output::image_text(&merged.header);
+    if let Err(e) = write_image(&out, &merged.film.resolve(), merged.header.gamma, &text) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }

@@ -4,12 +4,13 @@ use std::path::{Path, PathBuf};
 
 use lucent_io::desc::SceneDesc;
 use lucent_io::diag::{Diagnostics, Loc, Severity, SourceMap};
-use lucent_io::image::{encode_exr, encode_hdr, encode_png};
+use lucent_io::image::{encode_exr, encode_hdr, encode_jpeg, encode_png, ImageInfo};
 use lucent_io::resources::OutputTarget;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
     Png,
+    Jpeg,
     Exr,
     Hdr,
 }
@@ -24,10 +25,10 @@ pub struct Output {
 
 /// The output: `-o`, else the scene's `output` command (relative to the current
 /// directory), else `raytrace.png`. The extension picks the format: `.png` (8-bit, the
-/// course's encoding), `.exr` (linear 32-bit floats) or `.hdr` (Radiance RGBE); another
-/// name gets PNG, with a warning for a file (`-` for standard output and devices such as
-/// `/dev/null` get PNG silently). An output that cannot be written is an error now,
-/// before any work is done.
+/// course's encoding), `.jpg`/`.jpeg` (8-bit, the same encoding), `.exr` (linear 32-bit
+/// floats) or `.hdr` (Radiance RGBE); any other extension of a file is an error (never
+/// PNG bytes under another name); standard output (`-`) and devices such as `/dev/null`
+/// get PNG. An output that cannot be written is an error now, before any work is done.
 pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnostics) -> Result<Output, String> {
     let (name, loc): (PathBuf, Option<Loc>) = match (cli, &desc.output) {
         (Some(p), _) => (p.to_path_buf(), None),
@@ -43,30 +44,39 @@ pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnosti
         Some("exr") => Format::Exr,
         Some("hdr") => Format::Hdr,
         Some("png") => Format::Png,
+        Some("jpg" | "jpeg") => Format::Jpeg,
+        _ if !matches!(target, OutputTarget::File(_)) => Format::Png,
         _ => {
-            if matches!(target, OutputTarget::File(_)) {
-                let msg = format!(
-                    "output: '{}' does not end in .png, .exr or .hdr; writing PNG anyway",
-                    name.display()
-                );
-                match loc {
-                    Some(loc) => diags.warning(loc, msg),
-                    None => eprintln!("lucent: warning: {msg}"),
-                }
+            let msg = format!(
+                "'{}' does not end in .png, .jpg, .exr or .hdr: lucent cannot tell which format to write",
+                name.display()
+            );
+            if let Some(loc) = loc {
+                diags.error(loc, format!("output: {msg}"));
             }
-            Format::Png
+            return Err(msg);
         }
     };
     Ok(Output { name, format, target })
 }
 
-/// Encodes the film in the output's format and writes it (atomically for a file).
-pub fn write_image(out: &Output, film: &lucent_core::image::Image, gamma: f32) -> Result<(), String> {
+/// Encodes the film in the output's format and writes it (atomically for a file); PNG
+/// files carry `text` as tEXt chunks.
+pub fn write_image(out: &Output, film: &lucent_core::image::Image, gamma: f32, text: &[(String, String)]) -> Result<(), String> {
     let (w, h) = (film.width, film.height);
     let bytes = match out.format {
         Format::Exr => encode_exr(w, h, &film.to_rgb_f32()),
         Format::Hdr => encode_hdr(w, h, &film.to_rgb_f32()),
-        Format::Png => encode_png(w, h, &film.to_rgb8(gamma)),
+        Format::Jpeg => encode_jpeg(w, h, &film.to_rgb8(gamma)),
+        Format::Png => encode_png(
+            w,
+            h,
+            &film.to_rgb8(gamma),
+            &ImageInfo {
+                gamma,
+                text: text.to_vec(),
+            },
+        ),
     };
     bytes
         .and_then(|b| out.target.write(&b))
@@ -84,4 +94,15 @@ pub fn report(diags: &Diagnostics, sources: &SourceMap, notes: bool) {
     if !text.is_empty() {
         eprint!("{text}");
     }
+}
+
+/// The text an image carries about itself: lucent and its version, the scene's name, and
+/// what decides the pixels ([`lucent_io::state::describe_render`]) — not the command
+/// line, so that renders of the same pixels carry the same bytes however they were made.
+pub fn image_text(header: &lucent_io::state::StateHeader) -> Vec<(String, String)> {
+    vec![
+        ("Software".into(), format!("lucent {}", env!("CARGO_PKG_VERSION"))),
+        ("Source".into(), header.scene_name.clone()),
+        ("Comment".into(), lucent_io::state::describe_render(header)),
+    ]
 }

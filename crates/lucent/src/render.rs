@@ -223,6 +223,7 @@ pub fn run(args: &RenderArgs) -> u8 {
     };
     let header = |job: &RenderJob| StateHeader {
         scene_hash: session.desc.sources.digest(),
+        scene_name: args.scene.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
         resolution: (job.resolution.width, job.resolution.height),
         pixels: job.pixels,
         spp: job.spp,
@@ -353,7 +354,8 @@ pub fn run(args: &RenderArgs) -> u8 {
         eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
         return EXIT_BAD_INPUT;
     }
-    if let Err(e) = crate::output::write_image(&out, &film.resolve(), built.settings.gamma) {
+    let text = crate::output::image_text(&kept);
+    if let Err(e) = crate::output::write_image(&out, &film.resolve(), built.settings.gamma, &text) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
@@ -369,7 +371,7 @@ pub fn run(args: &RenderArgs) -> u8 {
             height: film.height,
             pixels: film.counts.iter().map(|&n| Color::splat(n as f32 * scale)).collect(),
         };
-        if let Err(e) = crate::output::write_image(map, &counts, 1.0) {
+        if let Err(e) = crate::output::write_image(map, &counts, 1.0, &text) {
             eprintln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
@@ -504,7 +506,7 @@ impl Partial {
     /// Writes the partial image and the state (each atomically).
     fn write(&self, film: &Film, header: StateHeader) -> Result<(), String> {
         if let Some(img) = &self.image {
-            crate::output::write_image(img, &film.resolve(), header.gamma)?;
+            crate::output::write_image(img, &film.resolve(), header.gamma, &crate::output::image_text(&header))?;
         }
         let state = RenderState {
             header,

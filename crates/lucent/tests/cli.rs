@@ -374,3 +374,33 @@ fn exr_and_hdr_keep_the_linear_values_png_encodes() {
     assert_eq!(png.get_pixel(2, 5).0, [255, 63, 255]);
     assert_eq!(files_in(&dir), ["e.test", "out.exr", "out.hdr", "out.png"]);
 }
+
+#[test]
+fn images_carry_what_they_are() {
+    let dir = workdir("metadata");
+    fs::write(dir.join("a.test"), format!("{SCENE}gamma 2.2\n")).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "-o", "x.png", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let png = fs::read(dir.join("x.png")).unwrap();
+    let find = |needle: &[u8]| png.windows(needle.len()).position(|w| w == needle);
+    // gAMA holds 1/2.2 × 100000 = 45455; text names lucent, the scene and the options.
+    let g = find(b"gAMA").expect("a gAMA chunk");
+    assert_eq!(u32::from_be_bytes(png[g + 4..g + 8].try_into().unwrap()), 45455);
+    assert!(find(b"cHRM").is_some());
+    assert!(find(format!("Software\0lucent {}", env!("CARGO_PKG_VERSION")).as_bytes()).is_some());
+    assert!(find(b"Source\0a.test").is_some());
+    assert!(find(b"32 x 24 image, pixels 0..32 x 0..24, samples 0..0 of 1 per pixel").is_some());
+    // Linear output says so: gAMA 1.
+    fs::write(dir.join("b.test"), SCENE).unwrap();
+    assert!(lucent(&dir, &["render", "b.test", "-o", "y.png", "-q"]).status.success());
+    let png = fs::read(dir.join("y.png")).unwrap();
+    let g = png.windows(4).position(|w| w == b"gAMA").unwrap();
+    assert_eq!(u32::from_be_bytes(png[g + 4..g + 8].try_into().unwrap()), 100000);
+    // A JPEG is a JPEG; an unknown extension is an error, and nothing is written.
+    assert!(lucent(&dir, &["render", "a.test", "-o", "x.jpg", "-q"]).status.success());
+    assert_eq!(&fs::read(dir.join("x.jpg")).unwrap()[..2], b"\xff\xd8");
+    let o = lucent(&dir, &["render", "a.test", "-o", "x.tif"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("'x.tif' does not end in .png, .jpg, .exr or .hdr"), "{}", stderr(&o));
+    assert!(!dir.join("x.tif").exists());
+}
