@@ -12,7 +12,7 @@ use lucent_core::render::job::RenderJob;
 use lucent_core::render::{render, RenderControl, RenderStats};
 
 use crate::build::{build, BuildOptions, Built};
-use crate::cse167::{parse_bytes, parse_file, ParseOptions};
+use crate::cse167::{parse_bytes, parse_file_with, ParseOptions};
 use crate::desc::SceneDesc;
 use crate::diag::Diagnostics;
 use crate::resources::{Budget, Resources};
@@ -53,9 +53,15 @@ pub struct Session {
 impl Session {
     /// Parses a scene file; nothing is built yet ([`Session::build`]).
     pub fn parse_file(path: &Path, options: SessionOptions) -> Session {
+        Session::parse_file_with(path, options, &[])
+    }
+
+    /// Parses a scene file, then `overrides` (scene settings from the command line, as
+    /// lines: `spp 64`), which replace what the file says.
+    pub fn parse_file_with(path: &Path, options: SessionOptions, overrides: &[String]) -> Session {
         let mut res = Resources::new(options.memory_limit);
         let mut s = Session::parse_with(options, || {
-            parse_file(path, ParseOptions { strict: options.strict }, &mut res)
+            parse_file_with(path, ParseOptions { strict: options.strict }, &mut res, overrides)
         });
         s.res = res;
         s

@@ -85,6 +85,19 @@ pub struct RenderArgs {
     /// not at all; they are removed when the render completes.
     #[arg(long, value_name = "SECS", value_parser = parse_seconds)]
     pub checkpoint: Option<f64>,
+    /// Override a scene setting, as Mitsuba's -D: `-D spp=64`, `-D integrator=pathtracer`,
+    /// `-D size=320,240` (commas or spaces between values); repeatable, the last wins.
+    #[arg(short = 'D', value_name = "NAME=VALUE", action = clap::ArgAction::Append)]
+    pub define: Vec<String>,
+    /// The image size, instead of the scene's `size` (the camera's view is the same).
+    #[arg(long, num_args = 2, value_names = ["W", "H"])]
+    pub size: Option<Vec<String>>,
+    /// The scene's `maxdepth` (-1: unbounded, with Russian roulette).
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    pub maxdepth: Option<String>,
+    /// A quick preview: half the size, at most 4 samples per pixel and 3 bounces.
+    #[arg(long)]
+    pub quick: bool,
     /// Acceleration structure.
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
     pub accel: String,
@@ -110,6 +123,44 @@ fn parse_threshold(s: &str) -> Result<f32, String> {
     }
 }
 
+/// The settings the command line overrides, as scene lines: `--size`, `--maxdepth`, then
+/// every `-D name=value` in order (the last wins).
+fn overrides(args: &RenderArgs) -> Vec<String> {
+    let mut lines = Vec::new();
+    if let Some(s) = &args.size {
+        lines.push(format!("size {}", s.join(" ")));
+    }
+    if let Some(d) = &args.maxdepth {
+        lines.push(format!("maxdepth {d}"));
+    }
+    for d in &args.define {
+        let (name, value) = d.split_once('=').unwrap_or((d, ""));
+        lines.push(format!("{} {}", name.trim(), value.replace(',', " ").trim()));
+    }
+    lines
+}
+
+/// `--quick`: half the image size, at most 4 samples per pixel and 3 scattering events
+/// (or mirror bounces).
+fn quick(desc: &mut lucent_io::desc::SceneDesc) {
+    if let Some(size) = &mut desc.size {
+        size.value = ((size.value.0 / 2).max(1), (size.value.1 / 2).max(1));
+    }
+    if let Some(spp) = &mut desc.spp {
+        spp.value = spp.value.min(4);
+    }
+    match &mut desc.max_depth {
+        Some(d) if d.value < 0 || d.value > 3 => d.value = 3,
+        Some(_) => {}
+        None => {
+            desc.max_depth = Some(lucent_io::desc::Located {
+                value: 3,
+                loc: desc.end,
+            })
+        }
+    }
+}
+
 /// `--checkpoint`: seconds, a finite number > 0.
 fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
@@ -132,7 +183,10 @@ pub fn run(args: &RenderArgs) -> u8 {
         accel,
         memory_limit: args.memory_limit.unwrap_or_else(Budget::machine_default),
     };
-    let mut session = Session::parse_file(&args.scene, options);
+    let mut session = Session::parse_file_with(&args.scene, options, &overrides(args));
+    if args.quick {
+        quick(&mut session.desc);
+    }
     if session.diags.has_errors() {
         report(&session.diags, &session.desc.sources, false);
         return EXIT_BAD_INPUT;
@@ -336,13 +390,16 @@ pub fn run(args: &RenderArgs) -> u8 {
     let mut kept = header(&job);
     kept.samples = first..job.samples.end;
 
+    let mut extra_warnings = 0;
     if stats.bad_samples > 0 {
+        extra_warnings += 1;
         eprintln!(
             "lucent: warning: {} samples were NaN or infinite and were replaced by black",
             stats.bad_samples
         );
     }
     if stats.cut_branches > 0 {
+        extra_warnings += 1;
         eprintln!(
             "lucent: warning: {} ray branches were not traced: too many were waiting at once (mirrors and glass that reflect everything, and a maxdepth above {})",
             stats.cut_branches,
@@ -401,6 +458,11 @@ pub fn run(args: &RenderArgs) -> u8 {
             stats.rays as f64 / render_s.max(1e-9) / 1e6,
             out.name.display()
         );
+    }
+    let warnings = session.diags.count(lucent_io::diag::Severity::Warning) + extra_warnings;
+    if warnings > 0 && !args.quiet {
+        let s = if warnings == 1 { "" } else { "s" };
+        eprintln!("lucent: {warnings} warning{s} (see above)");
     }
     if job.noise_threshold.is_some() && !args.quiet {
         eprintln!(

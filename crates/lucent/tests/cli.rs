@@ -404,3 +404,47 @@ fn images_carry_what_they_are() {
     assert!(stderr(&o).contains("'x.tif' does not end in .png, .jpg, .exr or .hdr"), "{}", stderr(&o));
     assert!(!dir.join("x.tif").exists());
 }
+
+#[test]
+fn the_command_line_overrides_scene_settings() {
+    let dir = workdir("overrides");
+    fs::write(dir.join("a.test"), format!("{SCENE}spp 9\n")).unwrap();
+    let size = |name: &str| image::image_dimensions(dir.join(name)).unwrap();
+    // -D (the last wins, commas or spaces), --size and --quick.
+    let o = lucent(&dir, &["render", "a.test", "-o", "d.png", "-D", "size=8,6", "-D", "size=10 4", "-D", "spp=1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(size("d.png"), (10, 4));
+    assert!(!stderr(&o).contains("given again"), "overrides replace silently: {}", stderr(&o));
+    assert!(lucent(&dir, &["render", "a.test", "-o", "s.png", "--size", "16", "12", "--maxdepth", "-1", "-q"]).status.success());
+    assert_eq!(size("s.png"), (16, 12));
+    assert!(lucent(&dir, &["render", "a.test", "-o", "q.png", "--quick", "-q"]).status.success());
+    assert_eq!(size("q.png"), (16, 12));
+    // An override with the same value renders the same pixels as the scene itself.
+    assert!(lucent(&dir, &["render", "a.test", "-o", "same.png", "-D", "spp=9", "-q"]).status.success());
+    assert!(lucent(&dir, &["render", "a.test", "-o", "plain.png", "-q"]).status.success());
+    let pixels = |name: &str| image::open(dir.join(name)).unwrap().to_rgb8().into_raw();
+    assert_eq!(pixels("same.png"), pixels("plain.png"));
+    // Errors point into the command line.
+    let o = lucent(&dir, &["render", "a.test", "-o", "x.png", "-D", "spp=0"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("command line:1:5: error: spp: "), "{}", stderr(&o));
+    let o = lucent(&dir, &["render", "a.test", "-o", "x.png", "-D", "sphere=1"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("-D: 'sphere' is not a scene setting"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_scene_that_can_only_be_black_says_so_and_counts_its_warnings() {
+    let dir = workdir("dark");
+    fs::write(dir.join("typo.test"), "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 0 0 5 1 1 1\nsphre 0 0 0 1\n").unwrap();
+    let o = lucent(&dir, &["render", "typo.test", "-o", "t.png"]);
+    assert!(o.status.success());
+    let err = stderr(&o);
+    assert!(err.contains("did you mean 'sphere'"), "{err}");
+    assert!(err.contains("warning: the scene has no objects"), "{err}");
+    assert!(err.contains("lucent: 2 warnings (see above)"), "{err}");
+    fs::write(dir.join("dark.test"), "size 8 8\nintegrator pathtracer\ncamera 0 0 5 0 0 0 0 1 0 45\nsphere 0 0 0 1\n").unwrap();
+    let err = stderr(&lucent(&dir, &["render", "dark.test", "-o", "d.png"]));
+    assert!(err.contains("warning: the scene has no light, no emissive object and no environment map"), "{err}");
+    assert!(err.contains("lucent: 1 warning (see above)"), "{err}");
+}

@@ -131,6 +131,7 @@ fn build_parts(
     };
     let scene = Scene::new(parts, options.accel);
     settings::control_depth(&mut integrator, &scene, desc.gamma() as f32);
+    settings::warn_if_dark(desc, &scene, diags);
     let work = settings::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
     Some(Built {
         scene,

@@ -135,6 +135,36 @@ pub struct Work {
 pub const ABSURD_RAYS: f64 = 1e10;
 pub const ABSURD_RAYS_PER_PIXEL: f64 = (1u64 << 20) as f64;
 
+/// Warns at the end of the scene when the picture can only be black or empty: no objects
+/// at all (a misspelt `sphere` is a warning of its own, easily missed), or nothing that
+/// lights them for this integrator.
+pub fn warn_if_dark(desc: &SceneDesc, scene: &Scene, diags: &mut Diagnostics) {
+    let kind = desc.integrator();
+    if scene.geometry.primitives.is_empty() {
+        let sky = if scene.environment.is_some() { " but the environment map" } else { "" };
+        diags.warning(desc.end, format!("the scene has no objects: the picture will show nothing{sky}"));
+        return;
+    }
+    let glows = desc.materials.iter().any(|m| m.emission != glam::DVec3::ZERO);
+    let ambient = desc.materials.iter().any(|m| m.ambient != glam::DVec3::ZERO);
+    let quads = scene.lights.iter().any(|l| !l.is_delta());
+    let lit = match kind {
+        IntegratorKind::RayTracer => !scene.lights.is_empty() || glows || ambient,
+        IntegratorKind::AnalyticDirect => quads,
+        IntegratorKind::Direct | IntegratorKind::PathTracer => {
+            !scene.lights.is_empty() || scene.emitters.is_some() || !scene.unsampled_emitters.is_empty() || scene.environment.is_some()
+        }
+    };
+    if !lit {
+        let what = match kind {
+            IntegratorKind::AnalyticDirect => "no quad light (the only light integrator analyticdirect renders)",
+            IntegratorKind::RayTracer => "no light, and no ambient or emission colour",
+            _ => "no light, no emissive object and no environment map",
+        };
+        diags.warning(desc.end, format!("the scene has {what}: the picture will be black"));
+    }
+}
+
 /// Estimates the work of rendering the whole image (`pixels` of them), and warns at the
 /// setting responsible when it is absurd.
 pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u64, diags: &mut Diagnostics) -> Work {

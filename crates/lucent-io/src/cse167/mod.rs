@@ -50,6 +50,11 @@ pub struct ParseOptions {
 /// Reads and parses a scene file (a regular file of at most [`MAX_SCENE_BYTES`]),
 /// recorded in `res`. A file that cannot be read is an error at `path:1:1`.
 pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (SceneDesc, Diagnostics) {
+    parse_file_with(path, options, res, &[])
+}
+
+/// [`parse_file`] with command-line overrides ([`parse_bytes_with`]).
+pub fn parse_file_with(path: &Path, options: ParseOptions, res: &mut Resources, overrides: &[String]) -> (SceneDesc, Diagnostics) {
     // The text, and then its description at about eight bytes for each byte of text,
     // are taken from the budget before the file is read.
     let size = std::fs::metadata(path).map_or(0, |m| m.len());
@@ -59,7 +64,7 @@ pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (S
         .take(size.saturating_mul(9), &what)
         .and_then(|_| read_input(path, MAX_SCENE_BYTES, &mut res.inputs));
     match read {
-        Ok(bytes) => parse_bytes(&path.display().to_string(), &bytes, options),
+        Ok(bytes) => parse_bytes_with(&path.display().to_string(), &bytes, options, overrides),
         Err(e) => {
             let mut desc = SceneDesc::default();
             let file = desc.sources.add(path.display().to_string(), Vec::new());
@@ -81,6 +86,31 @@ pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (S
 /// Parses scene text; `name` is what diagnostics call the file, and files the scene
 /// names are resolved against its folder.
 pub fn parse_bytes(name: &str, bytes: &[u8], options: ParseOptions) -> (SceneDesc, Diagnostics) {
+    parse_bytes_with(name, bytes, options, &[])
+}
+
+/// The scene settings a command line may override (`-D name=value`, `--size`, …).
+pub const SETTINGS: [&str; 13] = [
+    "size",
+    "output",
+    "maxdepth",
+    "gamma",
+    "integrator",
+    "spp",
+    "lightsamples",
+    "lightstratify",
+    "nexteventestimation",
+    "russianroulette",
+    "importancesampling",
+    "sampler",
+    "noisethreshold",
+];
+
+/// [`parse_bytes`], then `overrides`: lines of scene settings (`spp 64`) read as if they
+/// ended the file, each replacing what the file said without a warning. Their
+/// diagnostics point into a source called "command line"; a line that is not a setting
+/// is an error there.
+pub fn parse_bytes_with(name: &str, bytes: &[u8], options: ParseOptions, overrides: &[String]) -> (SceneDesc, Diagnostics) {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let raw_lines = lexer::split_lines(bytes);
     let shown: Vec<String> = raw_lines
@@ -95,6 +125,30 @@ pub fn parse_bytes(name: &str, bytes: &[u8], options: ParseOptions) -> (SceneDes
             break;
         }
         p.line(i as u32 + 1, raw);
+    }
+    if !overrides.is_empty() {
+        let file = p.file;
+        p.file = p.desc.sources.add("command line".into(), overrides.to_vec());
+        p.overriding = true;
+        for (i, line) in overrides.iter().enumerate() {
+            let name = line.split_whitespace().next().unwrap_or("");
+            if SETTINGS.contains(&name) {
+                p.line(i as u32 + 1, line.as_bytes());
+            } else {
+                let loc = Loc {
+                    file: p.file,
+                    line: i as u32 + 1,
+                    col: 1,
+                    len: name.len().max(1) as u32,
+                };
+                p.diags.error(
+                    loc,
+                    format!("-D: '{name}' is not a scene setting (one of {})", SETTINGS.join(", ")),
+                );
+            }
+        }
+        p.overriding = false;
+        p.file = file;
     }
     p.finish(raw_lines.len() as u32);
     (p.desc, p.diags)

@@ -35,6 +35,9 @@ pub(super) struct Parser {
     pub warned_verts: bool,
     pub warned_vert_norms: bool,
     pub seen_command: bool,
+    /// Reading command-line overrides: a setting given again replaces the file's
+    /// silently.
+    pub overriding: bool,
     /// Lines of the `pushTransform`s not popped yet.
     pub push_lines: Vec<u32>,
     /// The object being recorded (`objectbegin` without its `objectend` yet), with the
@@ -65,6 +68,7 @@ impl Parser {
             warned_verts: false,
             warned_vert_norms: false,
             seen_command: false,
+            overriding: false,
             push_lines: Vec::new(),
             object: None,
             displacement: None,
@@ -181,7 +185,7 @@ impl Parser {
         field: impl Fn(&mut SceneDesc) -> &mut Option<Located<T>>,
         value: Located<T>,
     ) {
-        if let Some(prev) = field(&mut self.desc) {
+        if let (Some(prev), false) = (field(&mut self.desc), self.overriding) {
             let line = prev.loc.line;
             self.warn_cmd(
                 c,

@@ -30,7 +30,7 @@ impl Parser {
             );
             return;
         }
-        if self.seen_command && self.desc.size.is_none() {
+        if self.seen_command && self.desc.size.is_none() && !self.overriding {
             self.warn_cmd(c, "size: should be the first command of the file");
         }
         let v = Located {
