@@ -393,9 +393,12 @@ pub fn run(args: &RenderArgs) -> u8 {
     let mut extra_warnings = 0;
     if stats.bad_samples > 0 {
         extra_warnings += 1;
+        let at: Vec<String> = stats.bad_pixels.list().iter().map(|(x, y)| format!("({x}, {y})")).collect();
+        let more = if stats.bad_samples > at.len() as u64 { ", …" } else { "" };
         eprintln!(
-            "lucent: warning: {} samples were NaN or infinite and were replaced by black",
-            stats.bad_samples
+            "lucent: warning: {} samples were NaN or infinite and were replaced by black, first at pixels {}{more}",
+            stats.bad_samples,
+            at.join(", ")
         );
     }
     if stats.cut_branches > 0 {
@@ -475,13 +478,15 @@ pub fn run(args: &RenderArgs) -> u8 {
     }
     if args.stats {
         eprintln!(
-            "parse {:.3} s, build {:.3} s ({} {:.1} MB), render {:.3} s on {} threads, write {:.3} s, total {:.3} s",
+            "parse {:.3} s, build {:.3} s ({} {:.1} MB), render {:.3} s on {} threads ({:.3} Msamples/s, {:.2} rays per sample), write {:.3} s, total {:.3} s",
             session.parse_seconds,
             session.build_seconds,
             scene.accel_kind().name(),
             scene.accel_memory_bytes() as f64 / 1e6,
             render_s,
             renderer.threads(),
+            stats.samples as f64 / render_s.max(1e-9) / 1e6,
+            stats.rays as f64 / stats.samples.max(1) as f64,
             (t_written - t_rendered).as_secs_f64(),
             (t_written - t_start).as_secs_f64(),
         );

@@ -39,6 +39,8 @@ pub struct RenderStats {
     pub rays: u64,
     /// Samples that came out NaN or infinite and were replaced by black.
     pub bad_samples: u64,
+    /// The first pixels (in reading order, `(x, y)`) where that happened, up to four.
+    pub bad_pixels: BadPixels,
     /// Branches of ray trees cut because too many were waiting at once
     /// ([`crate::integrator::whitted::MAX_PENDING`]).
     pub cut_branches: u64,
@@ -53,10 +55,44 @@ impl RenderStats {
     pub fn add(&mut self, other: &RenderStats) {
         self.rays += other.rays;
         self.bad_samples += other.bad_samples;
+        for &p in other.bad_pixels.list() {
+            self.bad_pixels.note(p);
+        }
         self.cut_branches += other.cut_branches;
         self.samples += other.samples;
         self.min_pixel_samples = self.min_pixel_samples.min(other.min_pixel_samples);
         self.max_pixel_samples = self.max_pixel_samples.max(other.max_pixel_samples);
+    }
+}
+
+/// The first few pixels, in reading order (row by row), that had a NaN or infinite
+/// sample: the same whichever thread found them first.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BadPixels {
+    pixels: [(u32, u32); 4],
+    len: usize,
+}
+
+impl BadPixels {
+    /// Keeps `(x, y)` if it is among the first four in reading order.
+    pub fn note(&mut self, p: (u32, u32)) {
+        let key = |q: &(u32, u32)| (q.1, q.0);
+        if self.list().contains(&p) {
+            return;
+        }
+        if self.len < 4 {
+            self.pixels[self.len] = p;
+            self.len += 1;
+        } else if let Some(last) = self.pixels.iter_mut().max_by_key(|q| key(q)) {
+            if key(&p) < key(last) {
+                *last = p;
+            }
+        }
+        self.pixels[..self.len].sort_by_key(key);
+    }
+
+    pub fn list(&self) -> &[(u32, u32)] {
+        &self.pixels[..self.len]
     }
 }
 
@@ -152,6 +188,7 @@ fn render_tile(
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
+    let mut bad_pixels = BadPixels::default();
     let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
     let n = job.spp.max(1);
     let sampling = integrator.pixel_sampling();
@@ -210,6 +247,7 @@ fn render_tile(
                     c
                 } else {
                     bad_samples += 1;
+                    bad_pixels.note((x, y));
                     Color::ZERO
                 };
                 // The box filter: every sample of the pixel counts the same.
@@ -236,6 +274,7 @@ fn render_tile(
     let stats = RenderStats {
         rays: counts.rays,
         bad_samples,
+        bad_pixels,
         cut_branches: counts.cut_branches,
         samples: taken_all,
         min_pixel_samples: taken_min,
@@ -300,5 +339,21 @@ mod tests {
         assert_eq!(a, shuffled_strata(0, 3, 7, 16, vec![9; 40]));
         assert_ne!(a, (0..16).collect::<Vec<_>>(), "not the pixel strata's order");
         assert_ne!(a, shuffled_strata(0, 4, 7, 16, Vec::new()));
+    }
+}
+
+#[cfg(test)]
+mod bad_pixel_tests {
+    use super::BadPixels;
+
+    #[test]
+    fn the_first_bad_pixels_in_reading_order_are_kept_whatever_the_order_found() {
+        let found = [(5, 2), (1, 0), (9, 9), (3, 2), (0, 1), (1, 0), (7, 0)];
+        let mut a = BadPixels::default();
+        found.iter().for_each(|&p| a.note(p));
+        let mut b = BadPixels::default();
+        found.iter().rev().for_each(|&p| b.note(p));
+        assert_eq!(a.list(), [(1, 0), (7, 0), (0, 1), (3, 2)]);
+        assert_eq!(a, b);
     }
 }
