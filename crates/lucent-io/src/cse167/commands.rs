@@ -61,6 +61,7 @@ const COMMANDS: &[(&str, Run)] = &[
     ("bumpmap", Parser::bump_map),
     ("displacementmap", Parser::displacement_map),
     ("envmap", Parser::environment),
+    ("include", Parser::include),
     // geometry.rs
     ("sphere", Parser::sphere),
     ("plane", Parser::analytic),

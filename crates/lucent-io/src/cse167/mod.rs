@@ -6,17 +6,20 @@
 //! attenuation, vertex piles); commands that create objects capture a snapshot of it.
 //! The parser checks each command where it stands — argument count, number syntax,
 //! ranges, indices, names — and records what it says with its location. It reads no
-//! other file and builds nothing: the build step ([`crate::build`]) does.
+//! other file but the scene text that `include` names, and builds nothing: the build
+//! step ([`crate::build`]) does.
 //!
 //! The rooms: [`lexer`] (lines and tokens), `args` (reading arguments), `parser` (the
 //! state and how objects capture it), `commands` (the command table that dispatches every
 //! line), and one file per family of commands: `settings`, `camera`, `transforms`,
-//! `lights`, `materials`, `textures`, `geometry`, `surfaces`, `nurbs`, `objects`.
+//! `lights`, `materials`, `textures`, `geometry`, `surfaces`, `nurbs`, `objects`, and
+//! `include` (the one command that reads another file: more scene text).
 
 mod args;
 mod camera;
 mod commands;
 mod geometry;
+mod include;
 mod lexer;
 mod lights;
 mod materials;
@@ -120,6 +123,9 @@ pub fn parse_bytes_with(name: &str, bytes: &[u8], options: ParseOptions, overrid
     let mut p = Parser::new(options);
     p.base_dir = Path::new(name).parent().map(Path::to_path_buf).unwrap_or_default();
     p.file = p.desc.sources.add(name.to_string(), shown);
+    if let Ok(canonical) = std::fs::canonicalize(name) {
+        p.include_stack.push(canonical);
+    }
     for (i, raw) in raw_lines.iter().enumerate() {
         if p.diags.too_many_errors() {
             break;

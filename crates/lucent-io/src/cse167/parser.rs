@@ -38,6 +38,11 @@ pub(super) struct Parser {
     /// Reading command-line overrides: a setting given again replaces the file's
     /// silently.
     pub overriding: bool,
+    /// The files being read, outermost first (canonical paths): `include` refuses
+    /// cycles by them.
+    pub include_stack: Vec<PathBuf>,
+    /// Bytes read by `include` so far (bounded like one scene file).
+    pub included_bytes: u64,
     /// Lines of the `pushTransform`s not popped yet.
     pub push_lines: Vec<u32>,
     /// The object being recorded (`objectbegin` without its `objectend` yet), with the
@@ -69,6 +74,8 @@ impl Parser {
             warned_vert_norms: false,
             seen_command: false,
             overriding: false,
+            include_stack: Vec::new(),
+            included_bytes: 0,
             push_lines: Vec::new(),
             object: None,
             displacement: None,

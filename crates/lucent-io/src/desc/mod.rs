@@ -101,6 +101,8 @@ pub struct SceneDesc {
     pub sources: SourceMap,
     /// Where the description ends (for "missing command" errors).
     pub end: Loc,
+    /// The files `include` read (their text is in `sources`).
+    pub included: Vec<std::path::PathBuf>,
 
     pub size: Option<Located<(u32, u32)>>,
     pub camera: Option<Located<CameraDesc>>,
@@ -192,6 +194,7 @@ impl SceneDesc {
             SurfaceRecipe::Nurbs(_) => None,
         });
         let env = self.environment.iter().map(|e| e.value.file.value.as_path());
-        textures.chain(surfaces).chain(env).collect()
+        let included = self.included.iter().map(|p| p.as_path());
+        textures.chain(surfaces).chain(env).chain(included).collect()
     }
 }
