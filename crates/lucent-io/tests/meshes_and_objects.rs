@@ -253,7 +253,10 @@ fn object_errors_point_at_the_command() {
     // An empty object may be instanced: it shows nothing.
     assert_eq!(
         m("objectbegin a\nobjectend\ninstance a\n"),
-        ["4:1: warning: objectend: object 'a' is empty"]
+        [
+            "4:1: warning: objectend: object 'a' is empty",
+            "5:1: warning: the scene has no objects: the picture will show nothing"
+        ]
     );
 }
 
