@@ -12,7 +12,7 @@ use lucent_core::render::job::RenderJob;
 use lucent_core::render::{render, RenderControl, RenderStats};
 
 use crate::build::{build, BuildOptions, Built};
-use crate::cse167::{parse_bytes, parse_file_with, ParseOptions};
+use crate::cse167::{parse_bytes_with, parse_file_with, ParseOptions};
 use crate::desc::SceneDesc;
 use crate::diag::Diagnostics;
 use crate::resources::{Budget, Resources};
@@ -70,8 +70,13 @@ impl Session {
     /// Parses scene text; `name` is what diagnostics call it, and the files it names are
     /// found beside it.
     pub fn parse_text(name: &str, text: &[u8], options: SessionOptions) -> Session {
+        Session::parse_text_with(name, text, options, &[])
+    }
+
+    /// [`Session::parse_text`] with command-line overrides ([`Session::parse_file_with`]).
+    pub fn parse_text_with(name: &str, text: &[u8], options: SessionOptions, overrides: &[String]) -> Session {
         Session::parse_with(options, || {
-            parse_bytes(name, text, ParseOptions { strict: options.strict })
+            parse_bytes_with(name, text, ParseOptions { strict: options.strict }, overrides)
         })
     }
 

@@ -31,10 +31,12 @@ use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// The scene file (CSE167/CSE168 format).
-    pub scene: PathBuf,
+    /// The scene files (CSE167/CSE168 format), rendered one after the other; `-` reads
+    /// a scene from standard input (its file names are relative to the current folder).
+    #[arg(required = true, value_name = "SCENE")]
+    pub scenes: Vec<PathBuf>,
     /// Output image (`-` for standard output); default: the scene's `output` command,
-    /// else raytrace.png.
+    /// else raytrace.png (with several scenes: SCENE.png beside each).
     #[arg(short, long, value_name = "OUT.png")]
     pub output: Option<PathBuf>,
     /// Worker threads (default: all cores). The image is the same for any count.
@@ -174,16 +176,57 @@ pub fn parse_size(s: &str) -> Result<u64, String> {
     lucent_io::resources::budget::parse_size(s)
 }
 
+/// Renders every scene named, one after the other; the exit code is the worst of them (a
+/// signal stops the run at once).
 pub fn run(args: &RenderArgs) -> u8 {
+    signals::install();
+    let several = args.scenes.len() > 1;
+    if several {
+        let single = [
+            (args.output.is_some(), "-o"),
+            (args.state.is_some(), "--state"),
+            (args.resume.is_some(), "--resume"),
+            (args.spp_map.is_some(), "--spp-map"),
+        ];
+        if let Some((_, flag)) = single.iter().find(|(given, _)| *given) {
+            eprintln!("lucent: error: {flag} names one file, and {} scenes were given: render them one at a time, or let each scene's output command (else SCENE.png beside it) name its image", args.scenes.len());
+            return EXIT_BAD_INPUT;
+        }
+        if args.scenes.iter().filter(|s| s.as_os_str() == "-").count() > 1 {
+            eprintln!("lucent: error: standard input (-) can hold one scene");
+            return EXIT_BAD_INPUT;
+        }
+    }
+    let mut worst = 0;
+    for scene in &args.scenes {
+        let code = run_one(args, scene, several);
+        if code >= 128 {
+            return code; // stopped by a signal
+        }
+        worst = worst.max(code);
+    }
+    worst
+}
+
+fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t_start = Instant::now();
-    signals::install();
     let options = SessionOptions {
         strict: args.strict,
         accel,
         memory_limit: args.memory_limit.unwrap_or_else(Budget::machine_default),
     };
-    let mut session = Session::parse_file_with(&args.scene, options, &overrides(args));
+    let mut session = if scene.as_os_str() == "-" {
+        let mut text = Vec::new();
+        let read = std::io::Read::read_to_end(&mut std::io::Read::take(std::io::stdin(), 1 << 30), &mut text);
+        if let Err(e) = read {
+            eprintln!("lucent: error: cannot read the scene from standard input: {e}");
+            return EXIT_BAD_INPUT;
+        }
+        Session::parse_text_with("-", &text, options, &overrides(args))
+    } else {
+        Session::parse_file_with(scene, options, &overrides(args))
+    };
     if args.quick {
         quick(&mut session.desc);
     }
@@ -193,7 +236,15 @@ pub fn run(args: &RenderArgs) -> u8 {
     }
     // The output is checked before the build, which may take long: that it can be
     // written, and that it is none of the files the scene names.
-    let out = match choose_output(args.output.as_deref(), &session.desc, &mut session.diags) {
+    // Several scenes, and this one names no output: SCENE.png beside it.
+    let own = (several && session.desc.output.is_none()).then(|| {
+        if scene.as_os_str() == "-" {
+            PathBuf::from("stdin.png")
+        } else {
+            scene.with_extension("png")
+        }
+    });
+    let out = match choose_output(args.output.as_deref().or(own.as_deref()), &session.desc, &mut session.diags) {
         Ok(out) => out,
         Err(msg) => {
             report(&session.diags, &session.desc.sources, false);
@@ -277,7 +328,11 @@ pub fn run(args: &RenderArgs) -> u8 {
     };
     let header = |job: &RenderJob| StateHeader {
         scene_hash: session.desc.sources.digest(),
-        scene_name: args.scene.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+        scene_name: if scene.as_os_str() == "-" {
+            "standard input".to_string()
+        } else {
+            scene.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned())
+        },
         resolution: (job.resolution.width, job.resolution.height),
         pixels: job.pixels,
         spp: job.spp,
@@ -362,7 +417,7 @@ pub fn run(args: &RenderArgs) -> u8 {
                 ..header(&job)
             };
             let how = if pixel_sampling == "uniform" {
-                format!("continue with: lucent render {} --resume {}", args.scene.display(), partial.state_name())
+                format!("continue with: lucent render {} --resume {}", scene.display(), partial.state_name())
             } else {
                 format!(
                     "render the rest with --samples {}..{} --state REST.lstate and put them together with lucent merge",

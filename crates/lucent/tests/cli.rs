@@ -448,3 +448,34 @@ fn a_scene_that_can_only_be_black_says_so_and_counts_its_warnings() {
     assert!(err.contains("warning: the scene has no light, no emissive object and no environment map"), "{err}");
     assert!(err.contains("lucent: 1 warning (see above)"), "{err}");
 }
+
+#[test]
+fn several_scenes_in_one_run_and_a_scene_on_standard_input() {
+    use std::io::Write;
+    let dir = workdir("several");
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    fs::write(dir.join("b.test"), format!("{SCENE}output named.png\n")).unwrap();
+    let o = lucent(&dir, &["render", "a.test", "b.test", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(dir.join("a.png").exists() && dir.join("named.png").exists());
+    let o = lucent(&dir, &["render", "a.test", "b.test", "-o", "x.png"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("-o names one file, and 2 scenes were given"), "{}", stderr(&o));
+    // A broken scene among good ones: the others are rendered, the exit code says it.
+    fs::write(dir.join("bad.test"), "size 8 8\nsphere 1\n").unwrap();
+    let o = lucent(&dir, &["render", "bad.test", "a.test", "-q"]);
+    assert_eq!(o.status.code(), Some(2));
+    // Standard input.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render", "-", "-o", "stdin.png", "-q"])
+        .current_dir(&dir)
+        .stdin(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(SCENE.as_bytes()).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let pixels = |name: &str| image::open(dir.join(name)).unwrap().to_rgb8().into_raw();
+    assert_eq!(pixels("stdin.png"), pixels("a.png"));
+}
