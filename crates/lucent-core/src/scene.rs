@@ -65,7 +65,7 @@ impl Scene {
             sampled_lights,
         } = parts;
         let found = if sampled_lights {
-            EmissiveSurfaces::new(&primitives, &materials)
+            EmissiveSurfaces::find(&primitives, &materials)
         } else {
             Emitters {
                 light: None,

@@ -38,7 +38,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an image.
-    Render(render::RenderArgs),
+    Render(Box<render::RenderArgs>),
     /// Parse and validate a scene without rendering it, and print what it holds.
     Check(check::CheckArgs),
     /// Compare two images (PNG or JPEG) pixel by pixel.

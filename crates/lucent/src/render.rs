@@ -601,9 +601,13 @@ struct Partial {
 impl Partial {
     fn beside(out: &Output, state: &Option<PathBuf>, desc: &lucent_io::desc::SceneDesc) -> Partial {
         let is_file = matches!(out.target, OutputTarget::File(_));
-        let with = |ext: &str| {
-            let stem = out.name.file_stem().map_or("render".into(), |s| s.to_string_lossy().into_owned());
-            out.name.with_file_name(format!("{stem}.partial.{ext}"))
+        // Beside a file; in the current folder for standard output or a device.
+        let with = |ext: &str| match is_file {
+            true => {
+                let stem = out.name.file_stem().map_or("render".into(), |s| s.to_string_lossy().into_owned());
+                out.name.with_file_name(format!("{stem}.partial.{ext}"))
+            }
+            false => PathBuf::from(format!("lucent.partial.{ext}")),
         };
         let ext = out.name.extension().map_or("png".into(), |e| e.to_string_lossy().into_owned());
         let mut quiet = lucent_io::diag::Diagnostics::default();

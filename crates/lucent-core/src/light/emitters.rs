@@ -42,7 +42,7 @@ pub struct EmissiveSurfaces {
     sampled: Vec<bool>,
 }
 
-/// What [`EmissiveSurfaces::new`] found.
+/// What [`EmissiveSurfaces::find`] found.
 pub struct Emitters {
     pub light: Option<EmissiveSurfaces>,
     /// Materials that emit on a plane or a quadric, which no light sampling can reach:
@@ -311,7 +311,7 @@ fn collect(
 
 impl EmissiveSurfaces {
     /// The emissive surfaces of `primitives` (whose materials are `materials`).
-    pub fn new(primitives: &[Primitive], materials: &[Material]) -> Emitters {
+    pub fn find(primitives: &[Primitive], materials: &[Material]) -> Emitters {
         let mut found = Vec::new();
         let mut unsampled = Vec::new();
         collect(primitives, None, materials, &mut found, &mut unsampled);
@@ -461,7 +461,7 @@ mod tests {
         // area below.)
         let prims: Vec<Primitive> = emissive_shapes().into_iter().skip(4).collect();
         let mats = materials();
-        let light = EmissiveSurfaces::new(&prims, &mats).light.unwrap();
+        let light = EmissiveSurfaces::find(&prims, &mats).light.unwrap();
         assert_eq!(light.piece_count(), 1 + 12 + 1);
         let geometry = Geometry::new(prims, Vec::new(), AccelKind::Bvh);
         let x = Vec3A::new(0.1, 0.05, 0.2);
@@ -586,13 +586,13 @@ mod tests {
         let plane = analytic(Affine3A::IDENTITY, AnalyticKind::Plane { point: Vec3A::ZERO, normal: Vec3A::Y }, 2);
         let mut prims = emissive_shapes();
         prims.push(plane);
-        let found = EmissiveSurfaces::new(&prims, &materials());
+        let found = EmissiveSurfaces::find(&prims, &materials());
         assert_eq!(found.unsampled, vec![(2, "plane")]);
         let light = found.light.unwrap();
         assert!(light.samples(1) && light.samples(3));
         assert!(!light.samples(2) && !light.samples(0));
         assert_eq!(light.piece_count(), 4 + 12, "the sphere and the disk of material 2 are out");
         // Nothing emits: no light.
-        assert!(EmissiveSurfaces::new(&emissive_shapes(), &[Material::default(); 4]).light.is_none());
+        assert!(EmissiveSurfaces::find(&emissive_shapes(), &[Material::default(); 4]).light.is_none());
     }
 }

@@ -104,6 +104,9 @@ pub struct RenderControl<'a> {
     pub cancel: &'a AtomicBool,
 }
 
+/// A tile's pixels, row by row: the sum of each one's samples and how many it took.
+type TilePixels = Vec<(ExactSum, u32)>;
+
 struct Tile {
     x0: u32,
     y0: u32,
@@ -143,7 +146,7 @@ pub fn render(
     // the progress callback's rate gives is honest from the first tiles on; where a
     // tile's pixels land does not depend on it.
     let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
-    let results: Vec<Option<(Vec<(ExactSum, u32)>, RenderStats)>> = order
+    let results: Vec<Option<(TilePixels, RenderStats)>> = order
         .par_iter()
         .map(|&t| {
             if control.cancel.load(Ordering::Relaxed) {
@@ -184,7 +187,7 @@ fn render_tile(
     job: &RenderJob,
     tile: &Tile,
     cancel: &AtomicBool,
-) -> Option<(Vec<(ExactSum, u32)>, RenderStats)> {
+) -> Option<(TilePixels, RenderStats)> {
     let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
