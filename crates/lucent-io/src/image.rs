@@ -35,12 +35,16 @@ pub fn encode_png(width: u32, height: u32, rgb: &[u8], info: &ImageInfo) -> Resu
 }
 
 /// What an image file says about itself besides its pixels: the gamma its 8-bit values
-/// are encoded with (1: linear) and text (PNG tEXt chunks: `Software`, `Source`,
-/// `Comment`…).
+/// are encoded with (1: linear), text (PNG tEXt chunks: `Software`, `Source`,
+/// `Comment`…) and where it lies in the whole picture.
 #[derive(Clone, Debug)]
 pub struct ImageInfo {
     pub gamma: f32,
     pub text: Vec<(String, String)>,
+    /// Where the image's top left pixel is in the whole picture, and the whole picture's
+    /// size (an EXR's data and display windows).
+    pub origin: (u32, u32),
+    pub full: (u32, u32),
 }
 
 /// Encodes 8-bit RGB as a JPEG (quality 95).
@@ -53,12 +57,30 @@ pub fn encode_jpeg(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Strin
 }
 
 /// Encodes linear RGB floats (interleaved, top row first) as an OpenEXR file (32-bit float
-/// channels): the render's values before clamping and encoding.
-pub fn encode_exr(width: u32, height: u32, rgb: &[f32]) -> Result<Vec<u8>, String> {
+/// channels, ZIP-compressed): the render's values before clamping and encoding. The data
+/// window is the region at `info.origin` inside the display window `info.full` (the whole
+/// image: a crop says where it belongs), and the header's `software` and `comments` carry
+/// `info.text`'s `Software` and `Comment`.
+pub fn encode_exr(width: u32, height: u32, rgb: &[f32], info: &ImageInfo) -> Result<Vec<u8>, String> {
+    use exr::prelude::*;
+    let w = width as usize;
+    let pixels = |p: Vec2<usize>| {
+        let i = 3 * (p.y() * w + p.x());
+        (rgb[i], rgb[i + 1], rgb[i + 2])
+    };
+    let mut attributes = LayerAttributes::default();
+    attributes.layer_position = Vec2(info.origin.0 as i32, info.origin.1 as i32);
+    let text = |key: &str| info.text.iter().find(|(k, _)| k == key).map(|(_, v)| Text::from(v.as_str()));
+    attributes.software_name = text("Software");
+    attributes.comments = text("Comment");
+    let layer = Layer::new((w, height as usize), attributes, Encoding::FAST_LOSSLESS, SpecificChannels::rgb(pixels));
+    let mut image = Image::from_layer(layer);
+    image.attributes.display_window = IntegerBounds::new((0, 0), (info.full.0 as usize, info.full.1 as usize));
     let mut out = std::io::Cursor::new(Vec::new());
-    let bytes: Vec<u8> = rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
-    image::codecs::openexr::OpenExrEncoder::new(&mut out)
-        .write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F)
+    image
+        .write()
+        .non_parallel()
+        .to_buffered(&mut out)
         .map_err(|e| e.to_string())?;
     Ok(out.into_inner())
 }

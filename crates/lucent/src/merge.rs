@@ -54,8 +54,7 @@ pub fn run(args: &MergeArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
-    let text = crate::output::image_text(&merged.header);
-    if let Err(e) = write_image(&out, &merged.film.resolve(), merged.header.gamma, &text) {
+    if let Err(e) = write_image(&out, &merged.film.resolve(), &crate::output::image_info(&merged.header)) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }

@@ -61,22 +61,15 @@ pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnosti
 }
 
 /// Encodes the film in the output's format and writes it (atomically for a file); PNG
-/// files carry `text` as tEXt chunks.
-pub fn write_image(out: &Output, film: &lucent_core::image::Image, gamma: f32, text: &[(String, String)]) -> Result<(), String> {
+/// and EXR files carry `info`'s text (and an EXR its place in the whole picture).
+pub fn write_image(out: &Output, film: &lucent_core::image::Image, info: &ImageInfo) -> Result<(), String> {
     let (w, h) = (film.width, film.height);
+    let gamma = info.gamma;
     let bytes = match out.format {
-        Format::Exr => encode_exr(w, h, &film.to_rgb_f32()),
+        Format::Exr => encode_exr(w, h, &film.to_rgb_f32(), info),
         Format::Hdr => encode_hdr(w, h, &film.to_rgb_f32()),
         Format::Jpeg => encode_jpeg(w, h, &film.to_rgb8(gamma)),
-        Format::Png => encode_png(
-            w,
-            h,
-            &film.to_rgb8(gamma),
-            &ImageInfo {
-                gamma,
-                text: text.to_vec(),
-            },
-        ),
+        Format::Png => encode_png(w, h, &film.to_rgb8(gamma), info),
     };
     bytes
         .and_then(|b| out.target.write(&b))
@@ -99,10 +92,15 @@ pub fn report(diags: &Diagnostics, sources: &SourceMap, notes: bool) {
 /// The text an image carries about itself: lucent and its version, the scene's name, and
 /// what decides the pixels ([`lucent_io::state::describe_render`]) — not the command
 /// line, so that renders of the same pixels carry the same bytes however they were made.
-pub fn image_text(header: &lucent_io::state::StateHeader) -> Vec<(String, String)> {
-    vec![
-        ("Software".into(), format!("lucent {}", env!("CARGO_PKG_VERSION"))),
-        ("Source".into(), header.scene_name.clone()),
-        ("Comment".into(), lucent_io::state::describe_render(header)),
-    ]
+pub fn image_info(header: &lucent_io::state::StateHeader) -> ImageInfo {
+    ImageInfo {
+        gamma: header.gamma,
+        text: vec![
+            ("Software".into(), format!("lucent {}", env!("CARGO_PKG_VERSION"))),
+            ("Source".into(), header.scene_name.clone()),
+            ("Comment".into(), lucent_io::state::describe_render(header)),
+        ],
+        origin: (header.pixels.x0, header.pixels.y0),
+        full: header.resolution,
+    }
 }

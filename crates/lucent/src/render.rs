@@ -469,8 +469,8 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
         return EXIT_BAD_INPUT;
     }
-    let text = crate::output::image_text(&kept);
-    if let Err(e) = crate::output::write_image(&out, &film.resolve(), built.settings.gamma, &text) {
+    let info = crate::output::image_info(&kept);
+    if let Err(e) = crate::output::write_image(&out, &film.resolve(), &info) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
@@ -486,7 +486,8 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             height: film.height,
             pixels: film.counts.iter().map(|&n| Color::splat(n as f32 * scale)).collect(),
         };
-        if let Err(e) = crate::output::write_image(map, &counts, 1.0, &text) {
+        let linear = lucent_io::image::ImageInfo { gamma: 1.0, ..info.clone() };
+        if let Err(e) = crate::output::write_image(map, &counts, &linear) {
             eprintln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
@@ -632,7 +633,7 @@ impl Partial {
     /// Writes the partial image and the state (each atomically).
     fn write(&self, film: &Film, header: StateHeader) -> Result<(), String> {
         if let Some(img) = &self.image {
-            crate::output::write_image(img, &film.resolve(), header.gamma, &crate::output::image_text(&header))?;
+            crate::output::write_image(img, &film.resolve(), &crate::output::image_info(&header))?;
         }
         let state = RenderState {
             header,

@@ -186,3 +186,31 @@ fn checkpoints_are_removed_when_the_render_completes() {
     let names = common::files_in(&dir);
     assert_eq!(names, ["a.lstate", "a.png", "b.png", "s.test"], "no partial files are left");
 }
+
+#[test]
+fn a_regions_exr_records_where_it_belongs() {
+    let dir = workdir("window");
+    fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
+    ok(&dir, &["render", "s.test", "-o", "part.exr", "-q", "--pixel-bounds", "10", "30", "5", "20"]);
+    let exr = fs::read(dir.join("part.exr")).unwrap();
+    // An attribute: name, type name, size, value (here a box2i: xmin ymin xmax ymax).
+    let box2i = |name: &str| {
+        let key = format!("{name}\0box2i\0");
+        let at = exr.windows(key.len()).position(|w| w == key.as_bytes()).unwrap() + key.len() + 4;
+        let v: Vec<i32> = (0..4).map(|k| i32::from_le_bytes(exr[at + 4 * k..at + 4 * k + 4].try_into().unwrap())).collect();
+        v
+    };
+    assert_eq!(box2i("dataWindow"), [10, 5, 29, 19]);
+    assert_eq!(box2i("displayWindow"), [0, 0, 39, 29]);
+    let text = String::from_utf8_lossy(&exr);
+    assert!(text.contains("pixels 10..30 x 5..20"), "the header says where the region belongs");
+    assert!(text.contains(&format!("lucent {}", env!("CARGO_PKG_VERSION"))));
+    // A reader shows it in its place in the whole picture, with the one-go render's values.
+    ok(&dir, &["render", "s.test", "-o", "one.exr", "-q"]);
+    let part = image::open(dir.join("part.exr")).unwrap().to_rgb32f();
+    let one = image::open(dir.join("one.exr")).unwrap().to_rgb32f();
+    assert_eq!((part.width(), part.height()), (40, 30));
+    assert_eq!(part.get_pixel(15, 10), one.get_pixel(15, 10));
+    assert_eq!(part.get_pixel(29, 19), one.get_pixel(29, 19));
+    assert_eq!(part.get_pixel(0, 0).0, [0.0; 3], "outside the data window");
+}
