@@ -1,4 +1,5 @@
-//! The progress bar: elapsed time and ETA on a terminal, nothing otherwise.
+//! The progress bar: the phase (building, rendering, writing), elapsed time and ETA on a
+//! terminal, nothing otherwise.
 
 use std::io::IsTerminal;
 
@@ -16,11 +17,26 @@ impl Progress {
         } else {
             let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr_with_hz(10));
             let style = ProgressStyle::with_template(
-                "{elapsed_precise} [{wide_bar}] {percent:>3}%  {human_pos}/{human_len} samples  ETA {eta_precise}",
+                "rendering {elapsed_precise} [{wide_bar}] {percent:>3}%  {human_pos}/{human_len} samples  ETA {eta_precise}",
             )
             .expect("valid template")
             .progress_chars("=> ");
             bar.set_style(style);
+            bar
+        };
+        Progress { bar }
+    }
+
+    /// A spinner naming a phase that has no count (`building`, `writing`), until
+    /// [`Progress::finish`].
+    pub fn phase(name: &str, quiet: bool) -> Progress {
+        let bar = if quiet || !std::io::stderr().is_terminal() {
+            ProgressBar::hidden()
+        } else {
+            let bar = ProgressBar::new_spinner();
+            bar.set_style(ProgressStyle::with_template("{msg} {elapsed_precise} {spinner}").expect("valid template"));
+            bar.set_message(name.to_string());
+            bar.enable_steady_tick(std::time::Duration::from_millis(200));
             bar
         };
         Progress { bar }

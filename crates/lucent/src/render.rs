@@ -294,7 +294,9 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             return EXIT_BAD_INPUT;
         }
     }
+    let building = Progress::phase("building", args.quiet);
     session.build();
+    building.finish();
     report(&session.diags, &session.desc.sources, false);
     let Some(built) = &session.built else {
         return EXIT_BAD_INPUT;
@@ -469,6 +471,8 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
         return EXIT_BAD_INPUT;
     }
+    let writing = Progress::phase("writing", args.quiet);
+    let _done_writing = Finish(&writing);
     let info = crate::output::image_info(&kept);
     if let Err(e) = crate::output::write_image(&out, &film.resolve(), &info) {
         eprintln!("lucent: error: {e}");
@@ -502,6 +506,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     if wrote_partial {
         partial.remove();
     }
+    writing.finish();
     let t_written = Instant::now();
 
     let scene = &built.scene;
@@ -653,5 +658,14 @@ impl Partial {
         if self.state.1 {
             let _ = std::fs::remove_file(&self.state.0);
         }
+    }
+}
+
+/// Clears a phase's spinner when the phase ends, however it ends.
+struct Finish<'a>(&'a Progress);
+
+impl Drop for Finish<'_> {
+    fn drop(&mut self) {
+        self.0.finish();
     }
 }
