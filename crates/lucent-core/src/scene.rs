@@ -79,7 +79,10 @@ impl Scene {
             materials,
             lights,
             textures,
-            environment_light: environment.as_ref().filter(|_| sampled_lights).and_then(EnvironmentLight::new),
+            environment_light: environment
+                .as_ref()
+                .filter(|_| sampled_lights)
+                .and_then(EnvironmentLight::new),
             environment,
             emitters: found.light,
             unsampled_emitters: found.unsampled,

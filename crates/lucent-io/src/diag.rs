@@ -46,16 +46,12 @@ impl SourceMap {
     /// files record as "the scene" (the files a scene reads besides its own text, meshes
     /// and images, are not part of it).
     pub fn digest(&self) -> u64 {
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        let mut h = crate::fnv::START;
         for f in &self.files {
             for line in &f.lines {
-                for &b in line.as_bytes().iter().chain(b"\n") {
-                    h ^= b as u64;
-                    h = h.wrapping_mul(0x0000_0100_0000_01b3);
-                }
+                h = crate::fnv::fnv1a(b"\n", crate::fnv::fnv1a(line.as_bytes(), h));
             }
-            h ^= 0xff;
-            h = h.wrapping_mul(0x0000_0100_0000_01b3);
+            h = crate::fnv::fnv1a(&[0xff], h);
         }
         h
     }

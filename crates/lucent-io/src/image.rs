@@ -17,7 +17,9 @@ pub fn encode_png(width: u32, height: u32, rgb: &[u8], info: &ImageInfo) -> Resu
         enc.set_depth(png::BitDepth::Eight);
         // What the bytes mean: the encoding exponent 1/g of SCENE_FORMAT.md §4.1 (1 for
         // linear values), with the sRGB / Rec. 709 primaries and white point.
-        enc.set_source_gamma(png::ScaledFloat::from_scaled((100_000.0 / info.gamma as f64).round() as u32));
+        enc.set_source_gamma(png::ScaledFloat::from_scaled(
+            (100_000.0 / info.gamma as f64).round() as u32
+        ));
         enc.set_source_chromaticities(png::SourceChromaticities::new(
             (0.3127, 0.3290),
             (0.64, 0.33),
@@ -70,10 +72,20 @@ pub fn encode_exr(width: u32, height: u32, rgb: &[f32], info: &ImageInfo) -> Res
     };
     let mut attributes = LayerAttributes::default();
     attributes.layer_position = Vec2(info.origin.0 as i32, info.origin.1 as i32);
-    let text = |key: &str| info.text.iter().find(|(k, _)| k == key).map(|(_, v)| Text::from(v.as_str()));
+    let text = |key: &str| {
+        info.text
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, v)| Text::from(v.as_str()))
+    };
     attributes.software_name = text("Software");
     attributes.comments = text("Comment");
-    let layer = Layer::new((w, height as usize), attributes, Encoding::FAST_LOSSLESS, SpecificChannels::rgb(pixels));
+    let layer = Layer::new(
+        (w, height as usize),
+        attributes,
+        Encoding::FAST_LOSSLESS,
+        SpecificChannels::rgb(pixels),
+    );
     let mut image = Image::from_layer(layer);
     image.attributes.display_window = IntegerBounds::new((0, 0), (info.full.0 as usize, info.full.1 as usize));
     let mut out = std::io::Cursor::new(Vec::new());

@@ -15,6 +15,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod diag;
+pub mod fnv;
 mod number;
 pub mod resources;
 

@@ -30,6 +30,8 @@ use std::ops::Range;
 use lucent_core::film::{ExactSum, Film};
 use lucent_core::render::job::PixelRect;
 
+use crate::fnv::{fnv1a, START as FNV_START};
+
 /// What a render state holds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderState {
@@ -59,16 +61,6 @@ pub struct StateHeader {
 
 const MAGIC: &str = "lucent-state 1";
 const PIXEL_BYTES: usize = 3 * 16 + 4;
-
-/// FNV-1a, 64 bits.
-pub fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-pub const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
 
 impl RenderState {
     pub fn encode(&self) -> Vec<u8> {
@@ -117,7 +109,8 @@ impl RenderState {
                 .position(|&b| b == b'\n')
                 .ok_or("not a lucent state file (its header is cut short)")?;
             pos += end + 1;
-            std::str::from_utf8(&rest[..end]).map_err(|_| "not a lucent state file (its header is not text)".to_string())
+            std::str::from_utf8(&rest[..end])
+                .map_err(|_| "not a lucent state file (its header is not text)".to_string())
         };
         if line()? != MAGIC {
             return Err(format!("not a lucent state file (it does not start with '{MAGIC}')"));
@@ -141,10 +134,17 @@ impl RenderState {
             }
             Ok(values)
         };
-        let num = |s: &str, what: &str| s.parse::<u64>().map_err(|_| format!("the header's {what} '{s}' is not a number"));
-        let small = |s: &str, what: &str| s.parse::<u32>().map_err(|_| format!("the header's {what} '{s}' is not a number"));
+        let num = |s: &str, what: &str| {
+            s.parse::<u64>()
+                .map_err(|_| format!("the header's {what} '{s}' is not a number"))
+        };
+        let small = |s: &str, what: &str| {
+            s.parse::<u32>()
+                .map_err(|_| format!("the header's {what} '{s}' is not a number"))
+        };
         let scene = field("scene", 1)?;
-        let scene_hash = u64::from_str_radix(&scene[0], 16).map_err(|_| "the header's scene hash is not hexadecimal")?;
+        let scene_hash =
+            u64::from_str_radix(&scene[0], 16).map_err(|_| "the header's scene hash is not hexadecimal")?;
         let scene_name = field("name", usize::MAX)?.remove(0);
         let r = field("resolution", 2)?;
         let resolution = (small(&r[0], "width")?, small(&r[1], "height")?);
@@ -162,7 +162,8 @@ impl RenderState {
         let sampler = field("sampler", 1)?.remove(0);
         let pixel_sampling = field("pixelsampling", 1)?.remove(0);
         let g = field("gamma", 1)?;
-        let gamma = f32::from_bits(u32::from_str_radix(&g[0], 16).map_err(|_| "the header's gamma is not hexadecimal")?);
+        let gamma =
+            f32::from_bits(u32::from_str_radix(&g[0], 16).map_err(|_| "the header's gamma is not hexadecimal")?);
         field("data", 0)?;
         if !(pixels.x0 < pixels.x1 && pixels.y0 < pixels.y1 && pixels.x1 <= resolution.0 && pixels.y1 <= resolution.1) {
             return Err("the header's pixels are not a rectangle inside its resolution".into());
@@ -225,9 +226,6 @@ fn describe(h: &StateHeader) -> String {
     )
 }
 
-/// Combines states of one render — regions, sample ranges or both — into one: every pixel
-/// of the combined rectangle must be covered by states whose sample ranges do not overlap
-/// and together make one range. `names` name the states in messages.
 /// What an image made from this state says about itself (PNG text): the scene (its name
 /// and hash) and everything that decides its pixels — the same for a render made in one
 /// go and one merged from parts, and it records where a region belongs.
@@ -252,22 +250,38 @@ pub fn describe_render(h: &StateHeader) -> String {
     )
 }
 
+impl StateHeader {
+    /// What differs between the renders two headers describe, apart from their pixels
+    /// and sample ranges (and their spp unless `same_spp`): `None` when they are parts
+    /// of one render.
+    pub fn difference(&self, other: &StateHeader, same_spp: bool) -> Option<&'static str> {
+        let differs = [
+            (self.scene_hash != other.scene_hash, "scene"),
+            (self.resolution != other.resolution, "resolution"),
+            (same_spp && self.spp != other.spp, "samples per pixel"),
+            (self.seed != other.seed, "seed"),
+            (self.sampler != other.sampler, "sampler"),
+            (
+                self.pixel_sampling != other.pixel_sampling,
+                "integrator's pixel sampling",
+            ),
+            (self.gamma.to_bits() != other.gamma.to_bits(), "gamma"),
+        ];
+        differs.iter().find(|(d, _)| *d).map(|(_, what)| *what)
+    }
+}
+
+/// Combines states of one render — regions, sample ranges or both — into one: every pixel
+/// of the combined rectangle must be covered by states whose sample ranges do not overlap
+/// and together make one range. `names` name the states in messages.
 pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, String> {
     let first = states.first().ok_or("nothing to merge")?;
-    let f = &first.header;
     for (s, name) in states.iter().zip(names).skip(1) {
-        let h = &s.header;
-        let differs = [
-            (h.scene_hash != f.scene_hash, "scene"),
-            (h.resolution != f.resolution, "resolution"),
-            (h.spp != f.spp, "samples per pixel"),
-            (h.seed != f.seed, "seed"),
-            (h.sampler != f.sampler, "sampler"),
-            (h.pixel_sampling != f.pixel_sampling, "integrator's pixel sampling"),
-            (h.gamma.to_bits() != f.gamma.to_bits(), "gamma"),
-        ];
-        if let Some((_, what)) = differs.iter().find(|(d, _)| *d) {
-            return Err(format!("{name} and {} are renders of a different {what}; they cannot be merged", names[0]));
+        if let Some(what) = s.header.difference(&first.header, true) {
+            return Err(format!(
+                "{name} and {} are renders of a different {what}; they cannot be merged",
+                names[0]
+            ));
         }
     }
     // Overlaps: two states that share a pixel must share no sample index.
@@ -323,7 +337,7 @@ pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, St
         header: StateHeader {
             pixels: union,
             samples: range,
-            ..f.clone()
+            ..first.header.clone()
         },
         film,
     })
@@ -373,14 +387,20 @@ mod tests {
         bad[n - 20] ^= 1;
         assert!(RenderState::decode(&bad).unwrap_err().contains("checksum"));
         assert!(RenderState::decode(&bytes[..n - 1]).unwrap_err().contains("cut short"));
-        assert!(RenderState::decode(b"P6\n").unwrap_err().contains("not a lucent state file"));
+        assert!(RenderState::decode(b"P6\n")
+            .unwrap_err()
+            .contains("not a lucent state file"));
     }
 
     #[test]
     fn merging_checks_overlaps_gaps_and_origins() {
         let names: Vec<String> = (0..4).map(|i| format!("s{i}")).collect();
         // Two halves of the sample range over the left half, one range over the right.
-        let parts = [state(rect(0, 4, 0, 4), 0..8), state(rect(0, 4, 0, 4), 8..16), state(rect(4, 8, 0, 4), 0..16)];
+        let parts = [
+            state(rect(0, 4, 0, 4), 0..8),
+            state(rect(0, 4, 0, 4), 8..16),
+            state(rect(4, 8, 0, 4), 0..16),
+        ];
         let m = merge(&parts, &names).unwrap();
         assert_eq!((m.header.pixels, m.header.samples.clone()), (rect(0, 8, 0, 4), 0..16));
         assert!(m.film.counts.iter().all(|&c| c == 16));
@@ -390,7 +410,11 @@ mod tests {
         // Gap in the samples of some pixels, and a hole in the rectangle.
         let e = merge(&[state(rect(0, 4, 0, 4), 0..16), state(rect(4, 8, 0, 4), 0..8)], &names).unwrap_err();
         assert!(e.contains("gap: pixel (4, 0)"), "{e}");
-        let e = merge(&[state(rect(0, 2, 0, 4), 0..16), state(rect(4, 8, 0, 4), 0..16)], &names).unwrap_err();
+        let e = merge(
+            &[state(rect(0, 2, 0, 4), 0..16), state(rect(4, 8, 0, 4), 0..16)],
+            &names,
+        )
+        .unwrap_err();
         assert!(e.contains("gap: pixel (2, 0)"), "{e}");
         // Another scene.
         let mut other = state(rect(4, 8, 0, 4), 0..16);

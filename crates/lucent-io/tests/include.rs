@@ -15,8 +15,20 @@ fn included_commands_act_where_the_include_stands() {
     dir.write("parts/ball.test", "sphere 0 0 0 1\ninclude ../lamp.test\n");
     dir.write("lamp.test", "point 0 0 5 1 1 1\n");
     let head = "size 9 9\ncamera 0 0 5 0 0 0 0 1 0 30\nambient 0 0 0\ndiffuse 0.5 0.25 0.125\n";
-    let included = render_scene(&dir.scene(), &format!("{head}translate 0.2 0 0\ninclude parts/ball.test\n"), AccelKind::Bvh, 1).0;
-    let inline = render_scene(&dir.scene(), &format!("{head}translate 0.2 0 0\nsphere 0 0 0 1\npoint 0 0 5 1 1 1\n"), AccelKind::Bvh, 1).0;
+    let included = render_scene(
+        &dir.scene(),
+        &format!("{head}translate 0.2 0 0\ninclude parts/ball.test\n"),
+        AccelKind::Bvh,
+        1,
+    )
+    .0;
+    let inline = render_scene(
+        &dir.scene(),
+        &format!("{head}translate 0.2 0 0\nsphere 0 0 0 1\npoint 0 0 5 1 1 1\n"),
+        AccelKind::Bvh,
+        1,
+    )
+    .0;
     assert_eq!(included.pixels, inline.pixels);
     assert!(included.pixels[40].x > 0.1, "the lit sphere is there");
 }
@@ -33,6 +45,14 @@ fn include_errors_point_into_the_right_file_and_name_the_cycle() {
     let b = dir.path("b.test");
     let s = dir.scene();
     assert!(d.contains(&format!("{b}:1:11: error: sphere:")), "{d}");
-    assert!(d.contains(&format!("{b}:2:9: error: include: a cycle: a.test includes b.test includes a.test")), "{d}");
-    assert!(d.contains(&format!("{s}:4:9: error: include: ")) && d.contains("missing.test"), "{d}");
+    assert!(
+        d.contains(&format!(
+            "{b}:2:9: error: include: a cycle: a.test includes b.test includes a.test"
+        )),
+        "{d}"
+    );
+    assert!(
+        d.contains(&format!("{s}:4:9: error: include: ")) && d.contains("missing.test"),
+        "{d}"
+    );
 }

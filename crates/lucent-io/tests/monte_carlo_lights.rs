@@ -41,7 +41,10 @@ fn rmse(a: &Image, b: &Image) -> f64 {
 fn write_sky(dir: &TempDir, name: &str, w: u32, h: u32, f: impl Fn(u32, u32) -> f32) {
     let f = &f;
     let data: Vec<f32> = (0..h).flat_map(|y| (0..w).flat_map(move |x| [f(x, y); 3])).collect();
-    image::Rgb32FImage::from_raw(w, h, data).unwrap().save(dir.0.join(name)).unwrap();
+    image::Rgb32FImage::from_raw(w, h, data)
+        .unwrap()
+        .save(dir.0.join(name))
+        .unwrap();
 }
 
 const MODES: [(&str, &str, &str); 5] = [
@@ -77,12 +80,22 @@ fn a_diffuse_sphere_under_a_constant_sky_has_radiance_albedo_times_sky() {
         );
         let (mean, se) = mean_and_error(&render(&dir.scene(), &text));
         eprintln!("sky {mode:?}: {mean:.4} ± {se:.4}");
-        assert!((mean - 0.4).abs() <= 5.0 * se + 1e-6 && (mean - 0.4).abs() <= 0.006, "{mode:?}: {mean} ± {se}, want 0.4");
+        assert!(
+            (mean - 0.4).abs() <= 5.0 * se + 1e-6 && (mean - 0.4).abs() <= 0.006,
+            "{mode:?}: {mean} ± {se}, want 0.4"
+        );
     }
     // Looking past the sphere: the sky itself, exactly.
-    let text = format!("size 4 4\nspp 4\n{}camera 0 0 3 0 0 6 0 1 0 15\nenvmap sky.exr 2\nsphere 0 0 0 1\n", integrator(MODES[3]));
+    let text = format!(
+        "size 4 4\nspp 4\n{}camera 0 0 3 0 0 6 0 1 0 15\nenvmap sky.exr 2\nsphere 0 0 0 1\n",
+        integrator(MODES[3])
+    );
     let img = render(&dir.scene(), &text);
-    assert!(img.pixels.iter().all(|p| (p.y - 0.8).abs() < 1e-6), "{:?}", img.pixels[0]);
+    assert!(
+        img.pixels.iter().all(|p| (p.y - 0.8).abs() < 1e-6),
+        "{:?}",
+        img.pixels[0]
+    );
 }
 
 #[test]
@@ -94,7 +107,13 @@ fn a_sun_in_the_sky_gives_a_clean_shadow_with_mis_at_16_samples() {
     // (measured: 72 times; 17 with a piecewise-constant instead of bilinear density in
     // the map's cells) and within 6% of the image's mean radiance (measured: 4.4%).
     let dir = TempDir::new("sun");
-    write_sky(&dir, "sun.exr", 64, 32, |x, y| if (20..22).contains(&x) && (8..10).contains(&y) { 3000.0 } else { 0.05 });
+    write_sky(&dir, "sun.exr", 64, 32, |x, y| {
+        if (20..22).contains(&x) && (8..10).contains(&y) {
+            3000.0
+        } else {
+            0.05
+        }
+    });
     let scene = |settings: &str, spp: u32| {
         format!(
             "size 32 24\nspp {spp}\nintegrator pathtracer\nmaxdepth 3\n{settings}\n\
@@ -103,12 +122,24 @@ fn a_sun_in_the_sky_gives_a_clean_shadow_with_mis_at_16_samples() {
              sphere 0 1 0 1\n"
         )
     };
-    let reference = render(&dir.scene(), &scene("nexteventestimation mis\nimportancesampling brdf", 1024));
-    let mis = render(&dir.scene(), &scene("nexteventestimation mis\nimportancesampling brdf", 16));
-    let brdf = render(&dir.scene(), &scene("nexteventestimation off\nimportancesampling brdf", 16));
+    let reference = render(
+        &dir.scene(),
+        &scene("nexteventestimation mis\nimportancesampling brdf", 1024),
+    );
+    let mis = render(
+        &dir.scene(),
+        &scene("nexteventestimation mis\nimportancesampling brdf", 16),
+    );
+    let brdf = render(
+        &dir.scene(),
+        &scene("nexteventestimation off\nimportancesampling brdf", 16),
+    );
     let mean = reference.pixels.iter().map(|p| p.y as f64).sum::<f64>() / reference.pixels.len() as f64;
     let (e_mis, e_brdf) = (rmse(&mis, &reference), rmse(&brdf, &reference));
-    eprintln!("sun: mean {mean:.3}, RMSE at 16 spp: MIS {e_mis:.4}, BSDF sampling {e_brdf:.4} ({:.1}x)", e_brdf / e_mis);
+    eprintln!(
+        "sun: mean {mean:.3}, RMSE at 16 spp: MIS {e_mis:.4}, BSDF sampling {e_brdf:.4} ({:.1}x)",
+        e_brdf / e_mis
+    );
     assert!(e_mis * 20.0 < e_brdf, "MIS {e_mis}, BSDF sampling {e_brdf}");
     assert!(e_mis < 0.06 * mean, "MIS {e_mis}, mean {mean}");
     // The shadow is there: on pixel row 13 the floor in the sphere's shadow (column 21)
@@ -181,7 +212,11 @@ fn an_emissive_plane_is_counted_by_the_paths_alone_and_said_so() {
         )
     };
     let d = diagnostics("plane.test", &text("on"), false);
-    assert!(d.iter().any(|w| w.contains("warning: emission: light sampling cannot draw points on a plane")), "{d:?}");
+    assert!(
+        d.iter()
+            .any(|w| w.contains("warning: emission: light sampling cannot draw points on a plane")),
+        "{d:?}"
+    );
     for nee in ["off", "on", "mis"] {
         let (mean, se) = mean_and_error(&render("plane.test", &text(nee)));
         eprintln!("emissive plane, nee {nee}: {mean:.4} ± {se:.4}");
@@ -193,10 +228,18 @@ fn an_emissive_plane_is_counted_by_the_paths_alone_and_said_so() {
 /// attenuation and a directional light: diffuse only, no ambient.
 fn lit_by_delta_lights(dir: &TempDir, integrator: &str) -> String {
     // A 4 × 4 texture of greys and colours, and a height field of ridges.
-    let tex: Vec<u8> = (0..16u8).flat_map(|i| [40 + 13 * i, 200 - 11 * i, 90 + (i % 4) * 40]).collect();
-    image::RgbImage::from_raw(4, 4, tex).unwrap().save(dir.0.join("tex.png")).unwrap();
+    let tex: Vec<u8> = (0..16u8)
+        .flat_map(|i| [40 + 13 * i, 200 - 11 * i, 90 + (i % 4) * 40])
+        .collect();
+    image::RgbImage::from_raw(4, 4, tex)
+        .unwrap()
+        .save(dir.0.join("tex.png"))
+        .unwrap();
     let bumps: Vec<u8> = (0..64u32).map(|i| if (i % 8) < 4 { 30 } else { 220 }).collect();
-    image::GrayImage::from_raw(8, 8, bumps).unwrap().save(dir.0.join("bumps.png")).unwrap();
+    image::GrayImage::from_raw(8, 8, bumps)
+        .unwrap()
+        .save(dir.0.join("bumps.png"))
+        .unwrap();
     format!(
         "size 40 30\nspp 1\n{integrator}\ncamera 0 4 7 0 0 0 0 1 0 50\nambient 0 0 0\nspecular 0 0 0\n\
          attenuation 1 0.1 0.05\npoint 1 3 2 2 2 2\ndirectional -1 2 1 0.4 0.35 0.3\n\
@@ -219,7 +262,10 @@ fn point_and_directional_lights_and_textures_light_as_in_the_ray_tracer() {
     let whitted = render(&dir.scene(), &lit_by_delta_lights(&dir, "maxdepth 0"));
     let lit = whitted.pixels.iter().filter(|p| p.y > 0.01).count();
     assert!(lit > 600, "the scene is lit: {lit} pixels");
-    for integrator in ["integrator direct", "integrator pathtracer\nmaxdepth 1\nnexteventestimation on"] {
+    for integrator in [
+        "integrator direct",
+        "integrator pathtracer\nmaxdepth 1\nnexteventestimation on",
+    ] {
         let mc = render(&dir.scene(), &lit_by_delta_lights(&dir, integrator));
         for (i, (w, m)) in whitted.pixels.iter().zip(&mc.pixels).enumerate() {
             let want = *w / std::f32::consts::PI;

@@ -1,8 +1,10 @@
 //! The part of a render the command line picks: `--crop x0 x1 y0 y1` (fractions of the
 //! image, pbrt's cropwindow), `--pixel-bounds x0 x1 y0 y1` (pixels, ends exclusive),
-//! `--samples FIRST..LAST` (inclusive, like Blender's frame ranges) and `--seed N`.
+//! `--samples FIRST..LAST` (inclusive, like Blender's frame ranges), `--seed N`, and
+//! `--resume STATE` (what an earlier render left to do).
 
 use lucent_core::render::job::{PixelRect, RenderJob};
+use lucent_io::state::{RenderState, StateHeader};
 
 /// `--samples FIRST..LAST`: the inclusive range as `FIRST..LAST+1`.
 pub fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
@@ -25,7 +27,12 @@ pub fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
 
 /// The pixels of `--crop` (pbrt's rule: the fractions times the resolution, rounded up)
 /// or `--pixel-bounds` within a `width × height` image.
-pub fn pixel_rect(crop: Option<&[f64]>, bounds: Option<&[u32]>, width: u32, height: u32) -> Result<Option<PixelRect>, String> {
+pub fn pixel_rect(
+    crop: Option<&[f64]>,
+    bounds: Option<&[u32]>,
+    width: u32,
+    height: u32,
+) -> Result<Option<PixelRect>, String> {
     let rect = match (crop, bounds) {
         (Some(c), _) => {
             if let Some(v) = c.iter().find(|v| !(0.0..=1.0).contains(*v)) {
@@ -72,6 +79,36 @@ pub fn apply_samples(job: &mut RenderJob, samples: &std::ops::Range<u32>) -> Res
     Ok(())
 }
 
+/// Reads the state to continue and points `job` at what is left: its pixels, the sample
+/// indices from its end to `job.spp`. The state must be of this scene and these options,
+/// from an integrator whose samples do not depend on the total (the Monte Carlo ones).
+pub fn resume(path: &std::path::Path, job: &mut RenderJob, now: &StateHeader) -> Result<RenderState, String> {
+    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    let state = RenderState::decode(&bytes)?;
+    let h = &state.header;
+    if let Some(what) = h.difference(now, false) {
+        let why = match what {
+            "scene" => "the scene's text has changed".to_string(),
+            _ => format!("the {what} differs"),
+        };
+        return Err(format!("it is not a render of this scene with these options: {why}"));
+    }
+    if h.pixel_sampling != "uniform" || h.spp < 2 || now.pixel_sampling != "uniform" {
+        return Err("only renders of the Monte Carlo integrators (direct, pathtracer) with spp 2 or more can be continued: the ray tracer places its samples on a grid that depends on spp, and spp 1 is the pixel centre".into());
+    }
+    if job.spp <= h.samples.end {
+        return Err(format!(
+            "it already holds samples {}..{}; ask for more with --spp (above {})",
+            h.samples.start,
+            h.samples.end - 1,
+            h.samples.end
+        ));
+    }
+    job.pixels = h.pixels;
+    job.samples = h.samples.end..job.spp;
+    Ok(state)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,7 +124,9 @@ mod tests {
 
     #[test]
     fn crops_round_up_as_pbrt_does() {
-        let r = pixel_rect(Some(&[0.0, 0.5, 0.25, 1.0]), None, 101, 10).unwrap().unwrap();
+        let r = pixel_rect(Some(&[0.0, 0.5, 0.25, 1.0]), None, 101, 10)
+            .unwrap()
+            .unwrap();
         assert_eq!((r.x0, r.x1, r.y0, r.y1), (0, 51, 3, 10));
         assert!(pixel_rect(Some(&[0.5, 0.5, 0.0, 1.0]), None, 10, 10).is_err());
         assert!(pixel_rect(None, Some(&[0, 11, 0, 1]), 10, 10).is_err());

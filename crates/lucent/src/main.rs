@@ -9,9 +9,11 @@ mod job_args;
 mod merge;
 mod oom;
 mod output;
+mod partial;
 mod passes;
 mod progress;
 mod render;
+mod settings_args;
 mod signals;
 
 use std::process::ExitCode;

@@ -31,7 +31,10 @@ pub fn run(args: &MergeArgs) -> u8 {
     let names: Vec<String> = args.inputs.iter().map(|p| p.display().to_string()).collect();
     let mut states = Vec::with_capacity(args.inputs.len());
     for (path, name) in args.inputs.iter().zip(&names) {
-        match std::fs::read(path).map_err(|e| e.to_string()).and_then(|b| RenderState::decode(&b)) {
+        match std::fs::read(path)
+            .map_err(|e| e.to_string())
+            .and_then(|b| RenderState::decode(&b))
+        {
             Ok(s) => states.push(s),
             Err(e) => {
                 eprintln!("lucent: error: {name}: {e}");

@@ -50,7 +50,11 @@ pub fn render_in_passes(
     let began = Instant::now();
     let mut last_save = Instant::now();
     let mut done = job.samples.start;
-    let mut size = if job.noise_threshold.is_some() { job.samples.len() as u32 } else { 1 };
+    let mut size = if job.noise_threshold.is_some() {
+        job.samples.len() as u32
+    } else {
+        1
+    };
     while done < job.samples.end {
         let pass = done..(done + size).min(job.samples.end);
         let pass_job = RenderJob {

@@ -50,3 +50,12 @@ impl Progress {
         self.bar.finish_and_clear();
     }
 }
+
+/// Clears a phase's spinner when the phase ends, however it ends.
+pub struct Finish<'a>(pub &'a Progress);
+
+impl Drop for Finish<'_> {
+    fn drop(&mut self) {
+        self.0.finish();
+    }
+}

@@ -10,10 +10,10 @@ use std::time::Instant;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
-use lucent_core::integrator::whitted::MAX_PENDING;
-use lucent_core::math::Color;
 use lucent_core::film::Film;
+use lucent_core::integrator::whitted::MAX_PENDING;
 use lucent_core::integrator::PixelSampling;
+use lucent_core::math::Color;
 use lucent_core::render::job::RenderJob;
 use lucent_core::sampler::SamplerKind;
 use lucent_io::resources::input::FileId;
@@ -21,11 +21,12 @@ use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::session::{Renderer, Session, SessionOptions};
 use lucent_io::state::{RenderState, StateHeader};
 
+use crate::job_args::{apply_samples, parse_samples, pixel_rect, resume};
 use crate::output::{choose_output, report};
-use crate::progress::Progress;
-use crate::job_args::{apply_samples, parse_samples, pixel_rect};
-use crate::output::Output;
+use crate::partial::Partial;
 use crate::passes::{render_in_passes, Outcome};
+use crate::progress::{Finish, Progress};
+use crate::settings_args::{overrides, quick};
 use crate::signals;
 use crate::EXIT_BAD_INPUT;
 
@@ -125,44 +126,6 @@ fn parse_threshold(s: &str) -> Result<f32, String> {
     }
 }
 
-/// The settings the command line overrides, as scene lines: `--size`, `--maxdepth`, then
-/// every `-D name=value` in order (the last wins).
-fn overrides(args: &RenderArgs) -> Vec<String> {
-    let mut lines = Vec::new();
-    if let Some(s) = &args.size {
-        lines.push(format!("size {}", s.join(" ")));
-    }
-    if let Some(d) = &args.maxdepth {
-        lines.push(format!("maxdepth {d}"));
-    }
-    for d in &args.define {
-        let (name, value) = d.split_once('=').unwrap_or((d, ""));
-        lines.push(format!("{} {}", name.trim(), value.replace(',', " ").trim()));
-    }
-    lines
-}
-
-/// `--quick`: half the image size, at most 4 samples per pixel and 3 scattering events
-/// (or mirror bounces).
-fn quick(desc: &mut lucent_io::desc::SceneDesc) {
-    if let Some(size) = &mut desc.size {
-        size.value = ((size.value.0 / 2).max(1), (size.value.1 / 2).max(1));
-    }
-    if let Some(spp) = &mut desc.spp {
-        spp.value = spp.value.min(4);
-    }
-    match &mut desc.max_depth {
-        Some(d) if d.value < 0 || d.value > 3 => d.value = 3,
-        Some(_) => {}
-        None => {
-            desc.max_depth = Some(lucent_io::desc::Located {
-                value: 3,
-                loc: desc.end,
-            })
-        }
-    }
-}
-
 /// `--checkpoint`: seconds, a finite number > 0.
 fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
@@ -216,6 +179,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         accel,
         memory_limit: args.memory_limit.unwrap_or_else(Budget::machine_default),
     };
+    let lines = overrides(args.size.as_deref(), args.maxdepth.as_deref(), &args.define);
     let mut session = if scene.as_os_str() == "-" {
         let mut text = Vec::new();
         let read = std::io::Read::read_to_end(&mut std::io::Read::take(std::io::stdin(), 1 << 30), &mut text);
@@ -223,9 +187,9 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             eprintln!("lucent: error: cannot read the scene from standard input: {e}");
             return EXIT_BAD_INPUT;
         }
-        Session::parse_text_with("-", &text, options, &overrides(args))
+        Session::parse_text_with("-", &text, options, &lines)
     } else {
-        Session::parse_file_with(scene, options, &overrides(args))
+        Session::parse_file_with(scene, options, &lines)
     };
     if args.quick {
         quick(&mut session.desc);
@@ -244,7 +208,11 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             scene.with_extension("png")
         }
     });
-    let out = match choose_output(args.output.as_deref().or(own.as_deref()), &session.desc, &mut session.diags) {
+    let out = match choose_output(
+        args.output.as_deref().or(own.as_deref()),
+        &session.desc,
+        &mut session.diags,
+    ) {
         Ok(out) => out,
         Err(msg) => {
             report(&session.diags, &session.desc.sources, false);
@@ -333,7 +301,9 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         scene_name: if scene.as_os_str() == "-" {
             "standard input".to_string()
         } else {
-            scene.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned())
+            scene
+                .file_name()
+                .map_or(String::new(), |n| n.to_string_lossy().into_owned())
         },
         resolution: (job.resolution.width, job.resolution.height),
         pixels: job.pixels,
@@ -419,7 +389,11 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
                 ..header(&job)
             };
             let how = if pixel_sampling == "uniform" {
-                format!("continue with: lucent render {} --resume {}", scene.display(), partial.state_name())
+                format!(
+                    "continue with: lucent render {} --resume {}",
+                    scene.display(),
+                    partial.state_name()
+                )
             } else {
                 format!(
                     "render the rest with --samples {}..{} --state REST.lstate and put them together with lucent merge",
@@ -450,8 +424,17 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     let mut extra_warnings = 0;
     if stats.bad_samples > 0 {
         extra_warnings += 1;
-        let at: Vec<String> = stats.bad_pixels.list().iter().map(|(x, y)| format!("({x}, {y})")).collect();
-        let more = if stats.bad_samples > at.len() as u64 { ", …" } else { "" };
+        let at: Vec<String> = stats
+            .bad_pixels
+            .list()
+            .iter()
+            .map(|(x, y)| format!("({x}, {y})"))
+            .collect();
+        let more = if stats.bad_samples > at.len() as u64 {
+            ", …"
+        } else {
+            ""
+        };
         eprintln!(
             "lucent: warning: {} samples were NaN or infinite and were replaced by black, first at pixels {}{more}",
             stats.bad_samples,
@@ -490,14 +473,20 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             height: film.height,
             pixels: film.counts.iter().map(|&n| Color::splat(n as f32 * scale)).collect(),
         };
-        let linear = lucent_io::image::ImageInfo { gamma: 1.0, ..info.clone() };
+        let linear = lucent_io::image::ImageInfo {
+            gamma: 1.0,
+            ..info.clone()
+        };
         if let Err(e) = crate::output::write_image(map, &counts, &linear) {
             eprintln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     }
     if let Some((name, target)) = &state_out {
-        let state = RenderState { header: kept, film: film.clone() };
+        let state = RenderState {
+            header: kept,
+            film: film.clone(),
+        };
         if let Err(e) = target.write(&state.encode()) {
             eprintln!("lucent: error: cannot write {}: {e}", name.display());
             return EXIT_BAD_INPUT;
@@ -555,39 +544,6 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     0
 }
 
-/// Reads the state to continue and points `job` at what is left: its pixels, the sample
-/// indices from its end to `job.spp`. The state must be of this scene and these options,
-/// from an integrator whose samples do not depend on the total (the Monte Carlo ones).
-fn resume(path: &std::path::Path, job: &mut RenderJob, now: &StateHeader) -> Result<RenderState, String> {
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    let state = RenderState::decode(&bytes)?;
-    let h = &state.header;
-    let differs = [
-        (h.scene_hash != now.scene_hash, "the scene's text has changed"),
-        (h.resolution != now.resolution, "the image size differs"),
-        (h.seed != now.seed, "the seed differs"),
-        (h.sampler != now.sampler, "the sampler differs"),
-        (h.gamma.to_bits() != now.gamma.to_bits(), "the gamma differs"),
-    ];
-    if let Some((_, why)) = differs.iter().find(|(d, _)| *d) {
-        return Err(format!("it is not a render of this scene with these options: {why}"));
-    }
-    if h.pixel_sampling != "uniform" || h.spp < 2 || now.pixel_sampling != "uniform" {
-        return Err("only renders of the Monte Carlo integrators (direct, pathtracer) with spp 2 or more can be continued: the ray tracer places its samples on a grid that depends on spp, and spp 1 is the pixel centre".into());
-    }
-    if job.spp <= h.samples.end {
-        return Err(format!(
-            "it already holds samples {}..{}; ask for more with --spp (above {})",
-            h.samples.start,
-            h.samples.end - 1,
-            h.samples.end
-        ));
-    }
-    job.pixels = h.pixels;
-    job.samples = h.samples.end..job.spp;
-    Ok(state)
-}
-
 /// Worker threads for `--threads N` (all cores without it), or the exit code after
 /// saying why they could not start.
 pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
@@ -595,77 +551,4 @@ pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
         eprintln!("lucent: error: {e}");
         1
     })
-}
-
-/// Where a partial render goes: `OUT.partial.EXT` beside the output (nothing for standard
-/// output or a device) and the state at `--state`, else `OUT.partial.lstate`.
-struct Partial {
-    image: Option<Output>,
-    state: (PathBuf, bool),
-}
-
-impl Partial {
-    fn beside(out: &Output, state: &Option<PathBuf>, desc: &lucent_io::desc::SceneDesc) -> Partial {
-        let is_file = matches!(out.target, OutputTarget::File(_));
-        // Beside a file; in the current folder for standard output or a device.
-        let with = |ext: &str| match is_file {
-            true => {
-                let stem = out.name.file_stem().map_or("render".into(), |s| s.to_string_lossy().into_owned());
-                out.name.with_file_name(format!("{stem}.partial.{ext}"))
-            }
-            false => PathBuf::from(format!("lucent.partial.{ext}")),
-        };
-        let ext = out.name.extension().map_or("png".into(), |e| e.to_string_lossy().into_owned());
-        let mut quiet = lucent_io::diag::Diagnostics::default();
-        let image = is_file
-            .then(|| crate::output::choose_output(Some(&with(&ext)), desc, &mut quiet).ok())
-            .flatten();
-        let state = match state {
-            Some(p) => (p.clone(), false),
-            None => (with("lstate"), true),
-        };
-        Partial { image, state }
-    }
-
-    fn image_name(&self) -> String {
-        self.image.as_ref().map_or("no image".into(), |o| o.name.display().to_string())
-    }
-
-    fn state_name(&self) -> String {
-        self.state.0.display().to_string()
-    }
-
-    /// Writes the partial image and the state (each atomically).
-    fn write(&self, film: &Film, header: StateHeader) -> Result<(), String> {
-        if let Some(img) = &self.image {
-            crate::output::write_image(img, &film.resolve(), &crate::output::image_info(&header))?;
-        }
-        let state = RenderState {
-            header,
-            film: film.clone(),
-        };
-        OutputTarget::resolve(&self.state.0)
-            .and_then(|t| t.write(&state.encode()))
-            .map_err(|e| format!("cannot write {}: {e}", self.state.0.display()))
-    }
-
-    /// Removes what checkpoints wrote, once the render is complete (the state at
-    /// `--state` is the final one by then, and stays).
-    fn remove(&self) {
-        if let Some(img) = &self.image {
-            let _ = std::fs::remove_file(&img.name);
-        }
-        if self.state.1 {
-            let _ = std::fs::remove_file(&self.state.0);
-        }
-    }
-}
-
-/// Clears a phase's spinner when the phase ends, however it ends.
-struct Finish<'a>(&'a Progress);
-
-impl Drop for Finish<'_> {
-    fn drop(&mut self) {
-        self.0.finish();
-    }
 }

@@ -392,16 +392,24 @@ fn images_carry_what_they_are() {
     assert!(find(b"32 x 24 image, pixels 0..32 x 0..24, samples 0..0 of 1 per pixel").is_some());
     // Linear output says so: gAMA 1.
     fs::write(dir.join("b.test"), SCENE).unwrap();
-    assert!(lucent(&dir, &["render", "b.test", "-o", "y.png", "-q"]).status.success());
+    assert!(lucent(&dir, &["render", "b.test", "-o", "y.png", "-q"])
+        .status
+        .success());
     let png = fs::read(dir.join("y.png")).unwrap();
     let g = png.windows(4).position(|w| w == b"gAMA").unwrap();
     assert_eq!(u32::from_be_bytes(png[g + 4..g + 8].try_into().unwrap()), 100000);
     // A JPEG is a JPEG; an unknown extension is an error, and nothing is written.
-    assert!(lucent(&dir, &["render", "a.test", "-o", "x.jpg", "-q"]).status.success());
+    assert!(lucent(&dir, &["render", "a.test", "-o", "x.jpg", "-q"])
+        .status
+        .success());
     assert_eq!(&fs::read(dir.join("x.jpg")).unwrap()[..2], b"\xff\xd8");
     let o = lucent(&dir, &["render", "a.test", "-o", "x.tif"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("'x.tif' does not end in .png, .jpg, .exr or .hdr"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("'x.tif' does not end in .png, .jpg, .exr or .hdr"),
+        "{}",
+        stderr(&o)
+    );
     assert!(!dir.join("x.tif").exists());
 }
 
@@ -411,17 +419,59 @@ fn the_command_line_overrides_scene_settings() {
     fs::write(dir.join("a.test"), format!("{SCENE}spp 9\n")).unwrap();
     let size = |name: &str| image::image_dimensions(dir.join(name)).unwrap();
     // -D (the last wins, commas or spaces), --size and --quick.
-    let o = lucent(&dir, &["render", "a.test", "-o", "d.png", "-D", "size=8,6", "-D", "size=10 4", "-D", "spp=1"]);
+    let o = lucent(
+        &dir,
+        &[
+            "render",
+            "a.test",
+            "-o",
+            "d.png",
+            "-D",
+            "size=8,6",
+            "-D",
+            "size=10 4",
+            "-D",
+            "spp=1",
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(size("d.png"), (10, 4));
-    assert!(!stderr(&o).contains("given again"), "overrides replace silently: {}", stderr(&o));
-    assert!(lucent(&dir, &["render", "a.test", "-o", "s.png", "--size", "16", "12", "--maxdepth", "-1", "-q"]).status.success());
+    assert!(
+        !stderr(&o).contains("given again"),
+        "overrides replace silently: {}",
+        stderr(&o)
+    );
+    assert!(lucent(
+        &dir,
+        &[
+            "render",
+            "a.test",
+            "-o",
+            "s.png",
+            "--size",
+            "16",
+            "12",
+            "--maxdepth",
+            "-1",
+            "-q"
+        ]
+    )
+    .status
+    .success());
     assert_eq!(size("s.png"), (16, 12));
-    assert!(lucent(&dir, &["render", "a.test", "-o", "q.png", "--quick", "-q"]).status.success());
+    assert!(lucent(&dir, &["render", "a.test", "-o", "q.png", "--quick", "-q"])
+        .status
+        .success());
     assert_eq!(size("q.png"), (16, 12));
     // An override with the same value renders the same pixels as the scene itself.
-    assert!(lucent(&dir, &["render", "a.test", "-o", "same.png", "-D", "spp=9", "-q"]).status.success());
-    assert!(lucent(&dir, &["render", "a.test", "-o", "plain.png", "-q"]).status.success());
+    assert!(
+        lucent(&dir, &["render", "a.test", "-o", "same.png", "-D", "spp=9", "-q"])
+            .status
+            .success()
+    );
+    assert!(lucent(&dir, &["render", "a.test", "-o", "plain.png", "-q"])
+        .status
+        .success());
     let pixels = |name: &str| image::open(dir.join(name)).unwrap().to_rgb8().into_raw();
     assert_eq!(pixels("same.png"), pixels("plain.png"));
     // Errors point into the command line.
@@ -430,22 +480,37 @@ fn the_command_line_overrides_scene_settings() {
     assert!(stderr(&o).contains("command line:1:5: error: spp: "), "{}", stderr(&o));
     let o = lucent(&dir, &["render", "a.test", "-o", "x.png", "-D", "sphere=1"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("-D: 'sphere' is not a scene setting"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("-D: 'sphere' is not a scene setting"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
 fn a_scene_that_can_only_be_black_says_so_and_counts_its_warnings() {
     let dir = workdir("dark");
-    fs::write(dir.join("typo.test"), "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 0 0 5 1 1 1\nsphre 0 0 0 1\n").unwrap();
+    fs::write(
+        dir.join("typo.test"),
+        "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 0 0 5 1 1 1\nsphre 0 0 0 1\n",
+    )
+    .unwrap();
     let o = lucent(&dir, &["render", "typo.test", "-o", "t.png"]);
     assert!(o.status.success());
     let err = stderr(&o);
     assert!(err.contains("did you mean 'sphere'"), "{err}");
     assert!(err.contains("warning: the scene has no objects"), "{err}");
     assert!(err.contains("lucent: 2 warnings (see above)"), "{err}");
-    fs::write(dir.join("dark.test"), "size 8 8\nintegrator pathtracer\ncamera 0 0 5 0 0 0 0 1 0 45\nsphere 0 0 0 1\n").unwrap();
+    fs::write(
+        dir.join("dark.test"),
+        "size 8 8\nintegrator pathtracer\ncamera 0 0 5 0 0 0 0 1 0 45\nsphere 0 0 0 1\n",
+    )
+    .unwrap();
     let err = stderr(&lucent(&dir, &["render", "dark.test", "-o", "d.png"]));
-    assert!(err.contains("warning: the scene has no light, no emissive object and no environment map"), "{err}");
+    assert!(
+        err.contains("warning: the scene has no light, no emissive object and no environment map"),
+        "{err}"
+    );
     assert!(err.contains("lucent: 1 warning (see above)"), "{err}");
 }
 
@@ -460,7 +525,11 @@ fn several_scenes_in_one_run_and_a_scene_on_standard_input() {
     assert!(dir.join("a.png").exists() && dir.join("named.png").exists());
     let o = lucent(&dir, &["render", "a.test", "b.test", "-o", "x.png"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(stderr(&o).contains("-o names one file, and 2 scenes were given"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("-o names one file, and 2 scenes were given"),
+        "{}",
+        stderr(&o)
+    );
     // A broken scene among good ones: the others are rendered, the exit code says it.
     fs::write(dir.join("bad.test"), "size 8 8\nsphere 1\n").unwrap();
     let o = lucent(&dir, &["render", "bad.test", "a.test", "-q"]);

@@ -480,10 +480,17 @@ fn the_environment_lights_tables_are_held_to_the_budget_in_the_monte_carlo_integ
     let dir = workdir("envbudget");
     fs::write(dir.join("sky.hdr"), flat_hdr(2048, 1024)).unwrap();
     let head = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\n";
-    fs::write(dir.join("pt.test"), format!("{head}integrator pathtracer\nenvmap sky.hdr\n")).unwrap();
+    fs::write(
+        dir.join("pt.test"),
+        format!("{head}integrator pathtracer\nenvmap sky.hdr\n"),
+    )
+    .unwrap();
     let r = run(&dir, &["check", "pt.test", "--memory-limit", "100M"], seconds(20));
     assert_eq!(r.code, Some(2), "{}", r.stderr);
-    says(&r, "pt.test:4:8: error: envmap: the environment light's sampling tables needs about 134 MB");
+    says(
+        &r,
+        "pt.test:4:8: error: envmap: the environment light's sampling tables needs about 134 MB",
+    );
     fs::write(dir.join("rt.test"), format!("{head}envmap sky.hdr\n")).unwrap();
     let r = run(&dir, &["check", "rt.test", "--memory-limit", "100M"], seconds(20));
     assert_eq!(r.code, Some(0), "the ray tracer needs no tables: {}", r.stderr);

@@ -38,6 +38,7 @@ const CORE: Floors = &[
 
 const IO: Floors = &[
     ("diag", 0),
+    ("fnv", 0),
     ("number", 0),
     ("resources", 0),
     ("desc", 1),
@@ -59,6 +60,8 @@ const CLI: Floors = &[
     ("signals", 0),
     ("oom", 0),
     ("job_args", 0),
+    ("settings_args", 0),
+    ("partial", 1),
     ("passes", 1),
     ("render", 2),
     ("check", 2),

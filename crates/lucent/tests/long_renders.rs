@@ -24,7 +24,11 @@ fn lucent(dir: &Path, args: &[&str]) -> Output {
 
 fn ok(dir: &Path, args: &[&str]) {
     let o = lucent(dir, args);
-    assert!(o.status.success(), "lucent {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "lucent {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 fn fails(dir: &Path, args: &[&str], says: &str) {
@@ -64,8 +68,28 @@ fn regions_and_sample_ranges_merge_into_the_bytes_of_the_one_go_render() {
         let spp = if k == 1 { 12 } else { 16 };
         let last = format!("5..{}", spp - 1);
         let parts: [&[&str]; 4] = [
-            &["--pixel-bounds", "0", "40", "0", "11", "--samples", "0..4", "--threads", "1"],
-            &["--pixel-bounds", "0", "40", "0", "11", "--samples", &last, "--threads", "2"],
+            &[
+                "--pixel-bounds",
+                "0",
+                "40",
+                "0",
+                "11",
+                "--samples",
+                "0..4",
+                "--threads",
+                "1",
+            ],
+            &[
+                "--pixel-bounds",
+                "0",
+                "40",
+                "0",
+                "11",
+                "--samples",
+                &last,
+                "--threads",
+                "2",
+            ],
             &["--crop", "0", "0.5", "0.35", "1"],
             &["--crop", "0.5", "1", "0.35", "1"],
         ];
@@ -81,8 +105,14 @@ fn regions_and_sample_ranges_merge_into_the_bytes_of_the_one_go_render() {
         args.extend(states.iter().map(String::as_str));
         ok(&dir, &[&args[..], &["-o", "m.png", "--state", "m.lstate"]].concat());
         ok(&dir, &["merge", "m.lstate", "-o", "m.exr"]);
-        assert!(fs::read(dir.join("one.png")).unwrap() == fs::read(dir.join("m.png")).unwrap(), "{integrator:?}: PNG");
-        assert!(fs::read(dir.join("one.exr")).unwrap() == fs::read(dir.join("m.exr")).unwrap(), "{integrator:?}: EXR");
+        assert!(
+            fs::read(dir.join("one.png")).unwrap() == fs::read(dir.join("m.png")).unwrap(),
+            "{integrator:?}: PNG"
+        );
+        assert!(
+            fs::read(dir.join("one.exr")).unwrap() == fs::read(dir.join("m.exr")).unwrap(),
+            "{integrator:?}: EXR"
+        );
         // A region's own image is the region: 20 × 20 pixels here (rows 11..30 of 30).
         let part = image::open(dir.join("part.png")).unwrap();
         assert_eq!((part.width(), part.height()), (20, 19), "{integrator:?}");
@@ -94,48 +124,156 @@ fn a_resumed_render_is_the_render_made_in_one_go() {
     let dir = workdir("resume");
     fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
     ok(&dir, &["render", "s.test", "-o", "one.exr", "-q", "--spp", "24"]);
-    ok(&dir, &["render", "s.test", "-o", "a.exr", "-q", "--spp", "8", "--state", "a.lstate"]);
-    ok(&dir, &["render", "s.test", "-o", "b.exr", "-q", "--resume", "a.lstate", "--spp", "16", "--state", "b.lstate"]);
-    ok(&dir, &["render", "s.test", "-o", "c.exr", "-q", "--resume", "b.lstate", "--spp", "24"]);
+    ok(
+        &dir,
+        &[
+            "render", "s.test", "-o", "a.exr", "-q", "--spp", "8", "--state", "a.lstate",
+        ],
+    );
+    ok(
+        &dir,
+        &[
+            "render", "s.test", "-o", "b.exr", "-q", "--resume", "a.lstate", "--spp", "16", "--state", "b.lstate",
+        ],
+    );
+    ok(
+        &dir,
+        &[
+            "render", "s.test", "-o", "c.exr", "-q", "--resume", "b.lstate", "--spp", "24",
+        ],
+    );
     assert!(fs::read(dir.join("one.exr")).unwrap() == fs::read(dir.join("c.exr")).unwrap());
-    fails(&dir, &["render", "s.test", "-o", "d.exr", "--resume", "b.lstate", "--spp", "16"], "already holds samples 0..15");
+    fails(
+        &dir,
+        &["render", "s.test", "-o", "d.exr", "--resume", "b.lstate", "--spp", "16"],
+        "already holds samples 0..15",
+    );
     // The ray tracer's samples sit on a grid of spp cells: it cannot be continued.
     fs::write(dir.join("w.test"), scene(INTEGRATORS[0])).unwrap();
     ok(&dir, &["render", "w.test", "-o", "w.png", "-q", "--state", "w.lstate"]);
-    fails(&dir, &["render", "w.test", "-o", "x.png", "--resume", "w.lstate", "--spp", "32"], "only renders of the Monte Carlo integrators");
+    fails(
+        &dir,
+        &["render", "w.test", "-o", "x.png", "--resume", "w.lstate", "--spp", "32"],
+        "only renders of the Monte Carlo integrators",
+    );
     // Another scene text, another seed.
-    fs::write(dir.join("t.test"), scene(INTEGRATORS[2]).replace("0.7 0.7 0.7", "0.6 0.7 0.7")).unwrap();
-    fails(&dir, &["render", "t.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16"], "the scene's text has changed");
-    fails(&dir, &["render", "s.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16", "--seed", "5"], "the seed differs");
+    fs::write(
+        dir.join("t.test"),
+        scene(INTEGRATORS[2]).replace("0.7 0.7 0.7", "0.6 0.7 0.7"),
+    )
+    .unwrap();
+    fails(
+        &dir,
+        &["render", "t.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16"],
+        "the scene's text has changed",
+    );
+    fails(
+        &dir,
+        &[
+            "render", "s.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16", "--seed", "5",
+        ],
+        "the seed differs",
+    );
 }
 
 #[test]
 fn merging_refuses_other_scenes_overlaps_gaps_and_damaged_files() {
     let dir = workdir("refuse");
     fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
-    fs::write(dir.join("t.test"), scene(INTEGRATORS[2]).replace("size 40 30", "size 40 30\nmaxdepth 4")).unwrap();
+    fs::write(
+        dir.join("t.test"),
+        scene(INTEGRATORS[2]).replace("size 40 30", "size 40 30\nmaxdepth 4"),
+    )
+    .unwrap();
     let half = |name: &str, scene: &str, y0: &str, y1: &str| {
-        ok(&dir, &["render", scene, "-o", "x.png", "-q", "--pixel-bounds", "0", "40", y0, y1, "--state", name]);
+        ok(
+            &dir,
+            &[
+                "render",
+                scene,
+                "-o",
+                "x.png",
+                "-q",
+                "--pixel-bounds",
+                "0",
+                "40",
+                y0,
+                y1,
+                "--state",
+                name,
+            ],
+        );
     };
     half("top.lstate", "s.test", "0", "15");
     half("bottom.lstate", "s.test", "15", "30");
     half("other.lstate", "t.test", "15", "30");
     half("big.lstate", "s.test", "10", "30");
-    fails(&dir, &["merge", "top.lstate", "other.lstate", "-o", "m.png"], "other.lstate and top.lstate are renders of a different scene");
+    fails(
+        &dir,
+        &["merge", "top.lstate", "other.lstate", "-o", "m.png"],
+        "other.lstate and top.lstate are renders of a different scene",
+    );
     fails(&dir, &["merge", "top.lstate", "big.lstate", "-o", "m.png"], "overlap");
-    ok(&dir, &["render", "s.test", "-o", "x.png", "-q", "--pixel-bounds", "0", "40", "15", "30", "--samples", "0..7", "--state", "few.lstate"]);
-    fails(&dir, &["merge", "top.lstate", "few.lstate", "-o", "m.png"], "a gap: pixel (0, 15) has 8 of the samples 0..15");
+    ok(
+        &dir,
+        &[
+            "render",
+            "s.test",
+            "-o",
+            "x.png",
+            "-q",
+            "--pixel-bounds",
+            "0",
+            "40",
+            "15",
+            "30",
+            "--samples",
+            "0..7",
+            "--state",
+            "few.lstate",
+        ],
+    );
+    fails(
+        &dir,
+        &["merge", "top.lstate", "few.lstate", "-o", "m.png"],
+        "a gap: pixel (0, 15) has 8 of the samples 0..15",
+    );
     let mut bytes = fs::read(dir.join("bottom.lstate")).unwrap();
     let n = bytes.len();
     bytes[n - 100] ^= 0x40;
     fs::write(dir.join("bad.lstate"), &bytes).unwrap();
-    fails(&dir, &["merge", "top.lstate", "bad.lstate", "-o", "m.png"], "bad.lstate: its pixel data does not match its checksum");
+    fails(
+        &dir,
+        &["merge", "top.lstate", "bad.lstate", "-o", "m.png"],
+        "bad.lstate: its pixel data does not match its checksum",
+    );
     assert!(!dir.join("m.png").exists(), "a refused merge writes nothing");
     ok(&dir, &["merge", "top.lstate", "bottom.lstate", "-o", "m.png"]);
     // Bad options are located errors too.
-    fails(&dir, &["render", "s.test", "-o", "x.png", "--samples", "0..99"], "--samples 0..99: the render has 16 samples per pixel");
-    fails(&dir, &["render", "s.test", "-o", "x.png", "--crop", "0.5", "0.2", "0", "1"], "--crop: pixels 20..8");
-    fails(&dir, &["render", "s.test", "-o", "x.png", "--noise-threshold", "0.1", "--samples", "0..3"], "adaptive sampling");
+    fails(
+        &dir,
+        &["render", "s.test", "-o", "x.png", "--samples", "0..99"],
+        "--samples 0..99: the render has 16 samples per pixel",
+    );
+    fails(
+        &dir,
+        &["render", "s.test", "-o", "x.png", "--crop", "0.5", "0.2", "0", "1"],
+        "--crop: pixels 20..8",
+    );
+    fails(
+        &dir,
+        &[
+            "render",
+            "s.test",
+            "-o",
+            "x.png",
+            "--noise-threshold",
+            "0.1",
+            "--samples",
+            "0..3",
+        ],
+        "adaptive sampling",
+    );
 }
 
 #[test]
@@ -162,16 +300,37 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
     let stopped = Instant::now();
     let out = child.wait_with_output().unwrap();
-    assert!(stopped.elapsed() < Duration::from_secs(3), "took {:?}", stopped.elapsed());
+    assert!(
+        stopped.elapsed() < Duration::from_secs(3),
+        "took {:?}",
+        stopped.elapsed()
+    );
     assert_eq!(out.status.code(), Some(130));
-    assert_eq!(fs::read(dir.join("out.exr")).unwrap(), b"an earlier render", "the final output is never replaced by a partial one");
+    assert_eq!(
+        fs::read(dir.join("out.exr")).unwrap(),
+        b"an earlier render",
+        "the final output is never replaced by a partial one"
+    );
     let state = lucent_io::state::RenderState::decode(&fs::read(dir.join("out.partial.lstate")).unwrap()).unwrap();
     let done = state.header.samples.clone();
     assert!(done.start == 0 && done.end >= 2, "{done:?}");
     assert!(dir.join("out.partial.exr").exists());
     // Resumed to a few more samples, it is the one-go render of that many.
     let spp = (done.end + 3).to_string();
-    ok(&dir, &["render", "s.test", "-o", "resumed.exr", "-q", "--resume", "out.partial.lstate", "--spp", &spp]);
+    ok(
+        &dir,
+        &[
+            "render",
+            "s.test",
+            "-o",
+            "resumed.exr",
+            "-q",
+            "--resume",
+            "out.partial.lstate",
+            "--spp",
+            &spp,
+        ],
+    );
     ok(&dir, &["render", "s.test", "-o", "one.exr", "-q", "--spp", &spp]);
     assert!(fs::read(dir.join("resumed.exr")).unwrap() == fs::read(dir.join("one.exr")).unwrap());
 }
@@ -180,30 +339,66 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
 fn checkpoints_are_removed_when_the_render_completes() {
     let dir = workdir("checkpoint");
     fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
-    ok(&dir, &["render", "s.test", "-o", "a.png", "-q", "--checkpoint", "0.001", "--state", "a.lstate"]);
+    ok(
+        &dir,
+        &[
+            "render",
+            "s.test",
+            "-o",
+            "a.png",
+            "-q",
+            "--checkpoint",
+            "0.001",
+            "--state",
+            "a.lstate",
+        ],
+    );
     ok(&dir, &["render", "s.test", "-o", "b.png", "-q"]);
     assert!(fs::read(dir.join("a.png")).unwrap() == fs::read(dir.join("b.png")).unwrap());
     let names = common::files_in(&dir);
-    assert_eq!(names, ["a.lstate", "a.png", "b.png", "s.test"], "no partial files are left");
+    assert_eq!(
+        names,
+        ["a.lstate", "a.png", "b.png", "s.test"],
+        "no partial files are left"
+    );
 }
 
 #[test]
 fn a_regions_exr_records_where_it_belongs() {
     let dir = workdir("window");
     fs::write(dir.join("s.test"), scene(INTEGRATORS[2])).unwrap();
-    ok(&dir, &["render", "s.test", "-o", "part.exr", "-q", "--pixel-bounds", "10", "30", "5", "20"]);
+    ok(
+        &dir,
+        &[
+            "render",
+            "s.test",
+            "-o",
+            "part.exr",
+            "-q",
+            "--pixel-bounds",
+            "10",
+            "30",
+            "5",
+            "20",
+        ],
+    );
     let exr = fs::read(dir.join("part.exr")).unwrap();
     // An attribute: name, type name, size, value (here a box2i: xmin ymin xmax ymax).
     let box2i = |name: &str| {
         let key = format!("{name}\0box2i\0");
         let at = exr.windows(key.len()).position(|w| w == key.as_bytes()).unwrap() + key.len() + 4;
-        let v: Vec<i32> = (0..4).map(|k| i32::from_le_bytes(exr[at + 4 * k..at + 4 * k + 4].try_into().unwrap())).collect();
+        let v: Vec<i32> = (0..4)
+            .map(|k| i32::from_le_bytes(exr[at + 4 * k..at + 4 * k + 4].try_into().unwrap()))
+            .collect();
         v
     };
     assert_eq!(box2i("dataWindow"), [10, 5, 29, 19]);
     assert_eq!(box2i("displayWindow"), [0, 0, 39, 29]);
     let text = String::from_utf8_lossy(&exr);
-    assert!(text.contains("pixels 10..30 x 5..20"), "the header says where the region belongs");
+    assert!(
+        text.contains("pixels 10..30 x 5..20"),
+        "the header says where the region belongs"
+    );
     assert!(text.contains(&format!("lucent {}", env!("CARGO_PKG_VERSION"))));
     // A reader shows it in its place in the whole picture, with the one-go render's values.
     ok(&dir, &["render", "s.test", "-o", "one.exr", "-q"]);

@@ -274,7 +274,14 @@ fn collect(
                             ))
                         };
                         // Each face as two triangles, by the corners' bit patterns.
-                        for face in [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]] {
+                        for face in [
+                            [0, 1, 3, 2],
+                            [4, 5, 7, 6],
+                            [0, 1, 5, 4],
+                            [2, 3, 7, 6],
+                            [0, 2, 6, 4],
+                            [1, 3, 7, 5],
+                        ] {
                             out.push((Piece::Triangle([c(face[0]), c(face[1]), c(face[2])]), prim.material));
                             out.push((Piece::Triangle([c(face[0]), c(face[2]), c(face[3])]), prim.material));
                         }
@@ -302,7 +309,13 @@ fn collect(
                 }
             }
             Shape::Instance(i) => {
-                collect(&i.object.primitives, Some(&compose(i.object_to_world)), materials, out, unsampled);
+                collect(
+                    &i.object.primitives,
+                    Some(&compose(i.object_to_world)),
+                    materials,
+                    out,
+                    unsampled,
+                );
             }
             _ => {}
         }
@@ -328,7 +341,10 @@ impl EmissiveSurfaces {
         let light = AliasTable::new(&weights).map(|choose| {
             let (pieces, piece_materials): (Vec<Piece>, Vec<u32>) = found.into_iter().unzip();
             EmissiveSurfaces {
-                radiance: piece_materials.iter().map(|&m| materials[m as usize].emission).collect(),
+                radiance: piece_materials
+                    .iter()
+                    .map(|&m| materials[m as usize].emission)
+                    .collect(),
                 pieces,
                 power,
                 choose,
@@ -423,13 +439,45 @@ mod tests {
             // An ellipsoid, a sphere, a sheared cylinder, a cone, a disk, a box, a
             // triangle, and a sphere that does not emit.
             Primitive::new(
-                Shape::Sphere(Sphere::new(place(Vec3::new(1.0, 0.4, 0.7), Vec3::new(1.0, 1.0, 0.0), 0.7, Vec3::new(-2.0, 0.0, 0.0)))),
+                Shape::Sphere(Sphere::new(place(
+                    Vec3::new(1.0, 0.4, 0.7),
+                    Vec3::new(1.0, 1.0, 0.0),
+                    0.7,
+                    Vec3::new(-2.0, 0.0, 0.0),
+                ))),
                 1,
             ),
-            Primitive::new(Shape::Sphere(Sphere::new(place(Vec3::splat(0.3), Vec3::X, 0.0, Vec3::new(0.0, 2.0, 0.5)))), 2),
-            analytic(shear, AnalyticKind::Cylinder { radius: 0.5, zmin: -1.0, zmax: 1.0 }, 1),
-            analytic(place(Vec3::ONE, Vec3::new(0.0, 1.0, 1.0), 1.2, Vec3::new(0.0, -2.0, 0.0)), AnalyticKind::Cone { radius: 0.8, height: 1.2 }, 3),
-            analytic(place(Vec3::new(1.0, 2.0, 1.0), Vec3::X, 0.4, Vec3::new(0.0, 0.0, -2.5)), AnalyticKind::Disk { radius: 0.6 }, 2),
+            Primitive::new(
+                Shape::Sphere(Sphere::new(place(
+                    Vec3::splat(0.3),
+                    Vec3::X,
+                    0.0,
+                    Vec3::new(0.0, 2.0, 0.5),
+                ))),
+                2,
+            ),
+            analytic(
+                shear,
+                AnalyticKind::Cylinder {
+                    radius: 0.5,
+                    zmin: -1.0,
+                    zmax: 1.0,
+                },
+                1,
+            ),
+            analytic(
+                place(Vec3::ONE, Vec3::new(0.0, 1.0, 1.0), 1.2, Vec3::new(0.0, -2.0, 0.0)),
+                AnalyticKind::Cone {
+                    radius: 0.8,
+                    height: 1.2,
+                },
+                3,
+            ),
+            analytic(
+                place(Vec3::new(1.0, 2.0, 1.0), Vec3::X, 0.4, Vec3::new(0.0, 0.0, -2.5)),
+                AnalyticKind::Disk { radius: 0.6 },
+                2,
+            ),
             analytic(
                 place(Vec3::new(1.0, 0.5, 2.0), Vec3::Y, 0.5, Vec3::new(-1.0, -1.0, 2.0)),
                 AnalyticKind::Cuboid(crate::aabb::Aabb::new(Vec3A::splat(-0.3), Vec3A::splat(0.3))),
@@ -437,12 +485,24 @@ mod tests {
             ),
             Primitive::new(
                 Shape::Triangle {
-                    p: [Vec3A::new(1.5, 1.5, 1.0), Vec3A::new(2.5, 1.0, 1.5), Vec3A::new(1.8, 2.5, 0.5)],
+                    p: [
+                        Vec3A::new(1.5, 1.5, 1.0),
+                        Vec3A::new(2.5, 1.0, 1.5),
+                        Vec3A::new(1.8, 2.5, 0.5),
+                    ],
                     normals: None,
                 },
                 1,
             ),
-            Primitive::new(Shape::Sphere(Sphere::new(place(Vec3::splat(0.2), Vec3::X, 0.0, Vec3::new(0.0, 0.5, 0.0)))), 0),
+            Primitive::new(
+                Shape::Sphere(Sphere::new(place(
+                    Vec3::splat(0.2),
+                    Vec3::X,
+                    0.0,
+                    Vec3::new(0.0, 0.5, 0.0),
+                ))),
+                0,
+            ),
         ]
     }
 
@@ -507,12 +567,30 @@ mod tests {
         // a 16 × 16 grid: each bin must get its share of the world area, the mean of
         // the stretch s over the bin (by an 8 × 8 midpoint rule) times its object area.
         let shapes = [
-            Mapped::new(ObjectSurface::Sphere, place(Vec3::new(1.0, 0.4, 3.0), Vec3::new(1.0, 1.0, 0.0), 0.7, Vec3::ZERO)),
             Mapped::new(
-                ObjectSurface::Cylinder { radius: 0.5, zmin: -1.0, zmax: 2.0 },
-                Affine3A::from_cols(Vec3A::X, Vec3A::new(0.6, 1.0, 0.0), Vec3A::new(0.0, 0.3, 0.5), Vec3A::ZERO),
+                ObjectSurface::Sphere,
+                place(Vec3::new(1.0, 0.4, 3.0), Vec3::new(1.0, 1.0, 0.0), 0.7, Vec3::ZERO),
             ),
-            Mapped::new(ObjectSurface::Cone { radius: 0.8, height: 1.2 }, place(Vec3::new(3.0, 1.0, 0.5), Vec3::Z, 0.3, Vec3::ONE)),
+            Mapped::new(
+                ObjectSurface::Cylinder {
+                    radius: 0.5,
+                    zmin: -1.0,
+                    zmax: 2.0,
+                },
+                Affine3A::from_cols(
+                    Vec3A::X,
+                    Vec3A::new(0.6, 1.0, 0.0),
+                    Vec3A::new(0.0, 0.3, 0.5),
+                    Vec3A::ZERO,
+                ),
+            ),
+            Mapped::new(
+                ObjectSurface::Cone {
+                    radius: 0.8,
+                    height: 1.2,
+                },
+                place(Vec3::new(3.0, 1.0, 0.5), Vec3::Z, 0.3, Vec3::ONE),
+            ),
         ];
         const B: usize = 16;
         for (k, m) in shapes.iter().enumerate() {
@@ -523,7 +601,10 @@ mod tests {
                 let (bu, bv) = ((b / B) as f32, (b % B) as f32);
                 for i in 0..8 {
                     for j in 0..8 {
-                        *e += s((bu + (i as f32 + 0.5) / 8.0) / B as f32, (bv + (j as f32 + 0.5) / 8.0) / B as f32);
+                        *e += s(
+                            (bu + (i as f32 + 0.5) / 8.0) / B as f32,
+                            (bv + (j as f32 + 0.5) / 8.0) / B as f32,
+                        );
                     }
                 }
             }
@@ -535,7 +616,10 @@ mod tests {
                 let (u, v) = crate::sampler::Sampler::new(5, i, 0, 0).uniform2();
                 let (p, normal) = m.point(u, v).expect("a point within 64 tries");
                 let (pu, pv) = parameters(m, p);
-                let (bu, bv) = (((pu * B as f32) as usize).min(B - 1), ((pv * B as f32) as usize).min(B - 1));
+                let (bu, bv) = (
+                    ((pu * B as f32) as usize).min(B - 1),
+                    ((pv * B as f32) as usize).min(B - 1),
+                );
                 observed[bu * B + bv] += 1.0;
                 // The normal is the surface's: perpendicular to the tangents (central
                 // differences of the parametrisation, away from the poles and the apex
@@ -564,26 +648,48 @@ mod tests {
         let spheroid = Mapped::new(ObjectSurface::Sphere, Affine3A::from_scale(Vec3::new(1.0, 1.0, 2.0)));
         let e = (1.0f32 - 0.25).sqrt();
         let exact = 2.0 * PI * (1.0 + 2.0 * e.asin() / e);
-        assert!((spheroid.area - exact).abs() < 1e-4 * exact, "{} {exact}", spheroid.area);
+        assert!(
+            (spheroid.area - exact).abs() < 1e-4 * exact,
+            "{} {exact}",
+            spheroid.area
+        );
         // A cylinder squashed into an elliptic one: the ellipse's perimeter (Ramanujan's
         // second formula is exact to 10⁻⁶ here) times the height.
         let elliptic = Mapped::new(
-            ObjectSurface::Cylinder { radius: 1.0, zmin: 0.0, zmax: 3.0 },
+            ObjectSurface::Cylinder {
+                radius: 1.0,
+                zmin: 0.0,
+                zmax: 3.0,
+            },
             Affine3A::from_scale(Vec3::new(2.0, 1.0, 1.0)),
         );
         let (a, b) = (2.0f32, 1.0f32);
         let h = ((a - b) / (a + b)).powi(2);
         let perimeter = PI * (a + b) * (1.0 + 3.0 * h / (10.0 + (4.0 - 3.0 * h).sqrt()));
-        assert!((elliptic.area - 3.0 * perimeter).abs() < 1e-4 * elliptic.area, "{}", elliptic.area);
+        assert!(
+            (elliptic.area - 3.0 * perimeter).abs() < 1e-4 * elliptic.area,
+            "{}",
+            elliptic.area
+        );
         // Under a rotation and a uniform scale no rejection is needed and the area is exact.
-        let sphere = Mapped::new(ObjectSurface::Sphere, place(Vec3::splat(2.0), Vec3::new(1.0, 2.0, 3.0), 0.9, Vec3::ONE));
+        let sphere = Mapped::new(
+            ObjectSurface::Sphere,
+            place(Vec3::splat(2.0), Vec3::new(1.0, 2.0, 3.0), 0.9, Vec3::ONE),
+        );
         assert!(sphere.s_max.is_none());
         assert!((sphere.area - 16.0 * PI).abs() < 1e-4 * sphere.area);
     }
 
     #[test]
     fn shapes_that_cannot_be_sampled_leave_their_material_to_the_paths() {
-        let plane = analytic(Affine3A::IDENTITY, AnalyticKind::Plane { point: Vec3A::ZERO, normal: Vec3A::Y }, 2);
+        let plane = analytic(
+            Affine3A::IDENTITY,
+            AnalyticKind::Plane {
+                point: Vec3A::ZERO,
+                normal: Vec3A::Y,
+            },
+            2,
+        );
         let mut prims = emissive_shapes();
         prims.push(plane);
         let found = EmissiveSurfaces::find(&prims, &materials());
@@ -591,8 +697,14 @@ mod tests {
         let light = found.light.unwrap();
         assert!(light.samples(1) && light.samples(3));
         assert!(!light.samples(2) && !light.samples(0));
-        assert_eq!(light.piece_count(), 4 + 12, "the sphere and the disk of material 2 are out");
+        assert_eq!(
+            light.piece_count(),
+            4 + 12,
+            "the sphere and the disk of material 2 are out"
+        );
         // Nothing emits: no light.
-        assert!(EmissiveSurfaces::find(&emissive_shapes(), &[Material::default(); 4]).light.is_none());
+        assert!(EmissiveSurfaces::find(&emissive_shapes(), &[Material::default(); 4])
+            .light
+            .is_none());
     }
 }

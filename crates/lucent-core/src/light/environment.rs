@@ -114,7 +114,10 @@ impl EnvironmentLight {
         let ((lu, lv), c) = self.cell(u, v);
         let y = sample_linear(lv, c[0] + c[1], c[2] + c[3]);
         let x = sample_linear(lu, (1.0 - y) * c[0] + y * c[2], (1.0 - y) * c[1] + y * c[3]);
-        let (i, j) = ((u * self.width as f32 - lu).round(), (v * self.height as f32 - lv).round());
+        let (i, j) = (
+            (u * self.width as f32 - lu).round(),
+            (v * self.height as f32 - lv).round(),
+        );
         let (u, v) = ((i + x) / self.width as f32, (j + y) / self.height as f32);
         let p_uv = p_cell * Self::within((x, y), c);
         let (sin_t, cos_t) = (PI * v).sin_cos();
@@ -148,8 +151,8 @@ impl EnvironmentLight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::chi2::chi2_test_edged;
     use crate::math::Color;
+    use crate::sampling::chi2::chi2_test_edged;
     use crate::shading::texture::Image;
 
     fn map(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> EnvironmentMap {
@@ -168,7 +171,15 @@ mod tests {
         // A map with a bright spot, a dark band and a gradient; and one lit only in a
         // corner, so that most of the sphere has density zero.
         let maps = [
-            map(16, 8, |x, y| if (x, y) == (5, 2) { 40.0 } else if y == 6 { 0.0 } else { 1.0 + x as f32 * 0.2 }),
+            map(16, 8, |x, y| {
+                if (x, y) == (5, 2) {
+                    40.0
+                } else if y == 6 {
+                    0.0
+                } else {
+                    1.0 + x as f32 * 0.2
+                }
+            }),
             map(12, 6, |x, y| if x < 2 && y < 2 { 3.0 } else { 0.0 }),
         ];
         for (k, m) in maps.iter().enumerate() {

@@ -134,7 +134,11 @@ impl Distribution2D {
             .chunks(width)
             .map(|row| Distribution1D::new(row.to_vec()))
             .collect();
-        let marginal = Distribution1D::new(rows.iter().map(|r| r.as_ref().map_or(0.0, |r| r.total() as f32)).collect())?;
+        let marginal = Distribution1D::new(
+            rows.iter()
+                .map(|r| r.as_ref().map_or(0.0, |r| r.total() as f32))
+                .collect(),
+        )?;
         Some(Distribution2D { rows, marginal })
     }
 
@@ -199,7 +203,10 @@ impl AliasTable {
         }
         // What is left is 1 up to rounding: kept whole.
         for i in small.into_iter().chain(large) {
-            entries[i] = AliasEntry { keep: 1.0, alias: i as u32 };
+            entries[i] = AliasEntry {
+                keep: 1.0,
+                alias: i as u32,
+            };
         }
         Some(AliasTable { entries })
     }
@@ -259,7 +266,11 @@ mod tests {
         for i in 0..n {
             counts[table.sample(Sampler::new(4, i, 0, 0).uniform())] += 1.0;
         }
-        assert_eq!((counts[1], counts[5]), (0.0, 0.0), "items of weight zero are never drawn");
+        assert_eq!(
+            (counts[1], counts[5]),
+            (0.0, 0.0),
+            "items of weight zero are never drawn"
+        );
         let keep: Vec<usize> = (0..8).filter(|&k| weights[k] > 0.0).collect();
         let observed: Vec<f64> = keep.iter().map(|&k| counts[k]).collect();
         let expected: Vec<f64> = keep.iter().map(|&k| (weights[k] / total) as f64 * n as f64).collect();
@@ -284,7 +295,9 @@ mod tests {
             assert_eq!(p, d.density_at(x));
             observed[(x * 64.0) as usize] += 1.0;
         }
-        let expected: Vec<f64> = (0..64).map(|b| d.density_at((b as f32 + 0.5) / 64.0) as f64 / 64.0 * n as f64).collect();
+        let expected: Vec<f64> = (0..64)
+            .map(|b| d.density_at((b as f32 + 0.5) / 64.0) as f64 / 64.0 * n as f64)
+            .collect();
         let r = pearson(&observed, &expected).unwrap();
         assert!(r.p_value >= SIGNIFICANCE, "{r:?}");
     }
@@ -292,7 +305,9 @@ mod tests {
     #[test]
     fn two_dimensional_samples_follow_their_density_and_integrate_to_one() {
         let (w, h) = (5, 3);
-        let weights = [1.0, 2.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 7.0, 1.0, 0.0];
+        let weights = [
+            1.0, 2.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 7.0, 1.0, 0.0,
+        ];
         let d = Distribution2D::new(w, h, &weights).unwrap();
         let total: f32 = weights.iter().sum();
         let mut integral = 0.0;

@@ -141,8 +141,15 @@ pub const ABSURD_RAYS_PER_PIXEL: f64 = (1u64 << 20) as f64;
 pub fn warn_if_dark(desc: &SceneDesc, scene: &Scene, diags: &mut Diagnostics) {
     let kind = desc.integrator();
     if scene.geometry.primitives.is_empty() {
-        let sky = if scene.environment.is_some() { " but the environment map" } else { "" };
-        diags.warning(desc.end, format!("the scene has no objects: the picture will show nothing{sky}"));
+        let sky = if scene.environment.is_some() {
+            " but the environment map"
+        } else {
+            ""
+        };
+        diags.warning(
+            desc.end,
+            format!("the scene has no objects: the picture will show nothing{sky}"),
+        );
         return;
     }
     let glows = desc.materials.iter().any(|m| m.emission != glam::DVec3::ZERO);
@@ -152,7 +159,10 @@ pub fn warn_if_dark(desc: &SceneDesc, scene: &Scene, diags: &mut Diagnostics) {
         IntegratorKind::RayTracer => !scene.lights.is_empty() || glows || ambient,
         IntegratorKind::AnalyticDirect => quads,
         IntegratorKind::Direct | IntegratorKind::PathTracer => {
-            !scene.lights.is_empty() || scene.emitters.is_some() || !scene.unsampled_emitters.is_empty() || scene.environment.is_some()
+            !scene.lights.is_empty()
+                || scene.emitters.is_some()
+                || !scene.unsampled_emitters.is_empty()
+                || scene.environment.is_some()
         }
     };
     if !lit {
@@ -356,7 +366,11 @@ fn check_integrator(desc: &SceneDesc, diags: &mut Diagnostics) {
             desc.materials[s.material as usize].emission != glam::DVec3::ZERO
                 && matches!(s.kind, ShapeKind::Plane { .. } | ShapeKind::Quadric { .. })
         }) {
-            let what = if matches!(s.kind, ShapeKind::Plane { .. }) { "plane" } else { "quadric" };
+            let what = if matches!(s.kind, ShapeKind::Plane { .. }) {
+                "plane"
+            } else {
+                "quadric"
+            };
             diags.warning(
                 s.loc,
                 format!(

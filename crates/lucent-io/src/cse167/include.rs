@@ -35,7 +35,10 @@ impl Parser {
             let chain: Vec<String> = self.include_stack[at..]
                 .iter()
                 .chain(std::iter::once(&canonical))
-                .map(|p| p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned()))
+                .map(|p| {
+                    p.file_name()
+                        .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+                })
                 .collect();
             self.err_arg(c, 0, format!("include: a cycle: {}", chain.join(" includes ")));
             return;

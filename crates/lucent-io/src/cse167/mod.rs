@@ -57,7 +57,12 @@ pub fn parse_file(path: &Path, options: ParseOptions, res: &mut Resources) -> (S
 }
 
 /// [`parse_file`] with command-line overrides ([`parse_bytes_with`]).
-pub fn parse_file_with(path: &Path, options: ParseOptions, res: &mut Resources, overrides: &[String]) -> (SceneDesc, Diagnostics) {
+pub fn parse_file_with(
+    path: &Path,
+    options: ParseOptions,
+    res: &mut Resources,
+    overrides: &[String],
+) -> (SceneDesc, Diagnostics) {
     // The text, and then its description at about eight bytes for each byte of text,
     // are taken from the budget before the file is read.
     let size = std::fs::metadata(path).map_or(0, |m| m.len());
@@ -113,7 +118,12 @@ pub const SETTINGS: [&str; 13] = [
 /// ended the file, each replacing what the file said without a warning. Their
 /// diagnostics point into a source called "command line"; a line that is not a setting
 /// is an error there.
-pub fn parse_bytes_with(name: &str, bytes: &[u8], options: ParseOptions, overrides: &[String]) -> (SceneDesc, Diagnostics) {
+pub fn parse_bytes_with(
+    name: &str,
+    bytes: &[u8],
+    options: ParseOptions,
+    overrides: &[String],
+) -> (SceneDesc, Diagnostics) {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let raw_lines = lexer::split_lines(bytes);
     let shown: Vec<String> = raw_lines

@@ -1,0 +1,83 @@
+//! Where a render's partial results go — checkpoints, and what an interrupt leaves —
+//! beside the output, never over it: `OUT.partial.EXT` and, without `--state`,
+//! `OUT.partial.lstate`.
+
+use std::path::PathBuf;
+
+use lucent_core::film::Film;
+use lucent_io::resources::OutputTarget;
+use lucent_io::state::{RenderState, StateHeader};
+
+use crate::output::Output;
+
+/// Where a partial render goes: `OUT.partial.EXT` beside the output (nothing for standard
+/// output or a device) and the state at `--state`, else `OUT.partial.lstate`.
+pub struct Partial {
+    image: Option<Output>,
+    state: (PathBuf, bool),
+}
+
+impl Partial {
+    pub fn beside(out: &Output, state: &Option<PathBuf>, desc: &lucent_io::desc::SceneDesc) -> Partial {
+        let is_file = matches!(out.target, OutputTarget::File(_));
+        // Beside a file; in the current folder for standard output or a device.
+        let with = |ext: &str| match is_file {
+            true => {
+                let stem = out
+                    .name
+                    .file_stem()
+                    .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+                out.name.with_file_name(format!("{stem}.partial.{ext}"))
+            }
+            false => PathBuf::from(format!("lucent.partial.{ext}")),
+        };
+        let ext = out
+            .name
+            .extension()
+            .map_or("png".into(), |e| e.to_string_lossy().into_owned());
+        let mut quiet = lucent_io::diag::Diagnostics::default();
+        let image = is_file
+            .then(|| crate::output::choose_output(Some(&with(&ext)), desc, &mut quiet).ok())
+            .flatten();
+        let state = match state {
+            Some(p) => (p.clone(), false),
+            None => (with("lstate"), true),
+        };
+        Partial { image, state }
+    }
+
+    pub fn image_name(&self) -> String {
+        self.image
+            .as_ref()
+            .map_or("no image".into(), |o| o.name.display().to_string())
+    }
+
+    pub fn state_name(&self) -> String {
+        self.state.0.display().to_string()
+    }
+
+    /// Writes the partial image and the state (each atomically).
+    pub fn write(&self, film: &Film, header: StateHeader) -> Result<(), String> {
+        if let Some(img) = &self.image {
+            crate::output::write_image(img, &film.resolve(), &crate::output::image_info(&header))?;
+        }
+        let state = RenderState {
+            header,
+            film: film.clone(),
+        };
+        OutputTarget::resolve(&self.state.0)
+            .and_then(|t| t.write(&state.encode()))
+            .map_err(|e| format!("cannot write {}: {e}", self.state.0.display()))
+    }
+
+    /// Removes what checkpoints wrote, once the render is complete (the state at
+    /// `--state` is the final one by then, and stays).
+    pub fn remove(&self) {
+        if let Some(img) = &self.image {
+            let _ = std::fs::remove_file(&img.name);
+        }
+        if self.state.1 {
+            let _ = std::fs::remove_file(&self.state.0);
+        }
+    }
+}
