@@ -59,17 +59,35 @@ pub fn encode_jpeg(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, Strin
 }
 
 /// Encodes linear RGB floats (interleaved, top row first) as an OpenEXR file (32-bit float
-/// channels, ZIP-compressed): the render's values before clamping and encoding. The data
-/// window is the region at `info.origin` inside the display window `info.full` (the whole
-/// image: a crop says where it belongs), and the header's `software` and `comments` carry
-/// `info.text`'s `Software` and `Comment`.
+/// channels, ZIP-compressed): the render's values before clamping and encoding. See
+/// [`encode_exr_channels`].
 pub fn encode_exr(width: u32, height: u32, rgb: &[f32], info: &ImageInfo) -> Result<Vec<u8>, String> {
+    let plane = |k: usize| rgb.iter().skip(k).step_by(3).copied().collect::<Vec<f32>>();
+    let channels = vec![
+        ("R".to_string(), plane(0)),
+        ("G".to_string(), plane(1)),
+        ("B".to_string(), plane(2)),
+    ];
+    encode_exr_channels(width, height, channels, info)
+}
+
+/// Encodes named channels of 32-bit floats (each a plane, top row first) as one
+/// OpenEXR image, ZIP-compressed: `R`, `G`, `B` (and `A`) are the picture, names like
+/// `albedo.R` or `normal.X` its layers, as Blender and Nuke name them. The data window is
+/// the region at `info.origin` inside the display window `info.full` (the whole image: a
+/// crop says where it belongs), and the header's `software` and `comments` carry
+/// `info.text`'s `Software` and `Comment`.
+pub fn encode_exr_channels(
+    width: u32,
+    height: u32,
+    channels: Vec<(String, Vec<f32>)>,
+    info: &ImageInfo,
+) -> Result<Vec<u8>, String> {
     use exr::prelude::*;
-    let w = width as usize;
-    let pixels = |p: Vec2<usize>| {
-        let i = 3 * (p.y() * w + p.x());
-        (rgb[i], rgb[i + 1], rgb[i + 2])
-    };
+    let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = channels
+        .into_iter()
+        .map(|(name, plane)| AnyChannel::new(name.as_str(), FlatSamples::F32(plane)))
+        .collect();
     let mut attributes = LayerAttributes::default();
     attributes.layer_position = Vec2(info.origin.0 as i32, info.origin.1 as i32);
     let text = |key: &str| {
@@ -81,10 +99,10 @@ pub fn encode_exr(width: u32, height: u32, rgb: &[f32], info: &ImageInfo) -> Res
     attributes.software_name = text("Software");
     attributes.comments = text("Comment");
     let layer = Layer::new(
-        (w, height as usize),
+        (width as usize, height as usize),
         attributes,
         Encoding::FAST_LOSSLESS,
-        SpecificChannels::rgb(pixels),
+        AnyChannels::sort(list),
     );
     let mut image = Image::from_layer(layer);
     image.attributes.display_window = IntegerBounds::new((0, 0), (info.full.0 as usize, info.full.1 as usize));

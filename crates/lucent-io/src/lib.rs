@@ -8,8 +8,8 @@
 //!
 //! Floors (checked by `tests/layering.rs` in the `lucent` crate): `diag`, `number`,
 //! `files` → `desc` → `cse167` (the parser: records, reads no other file) → the file
-//! formats (`obj`, `ply`, `mesh_file`, `patches`, `texture_file`, `image`) and render
-//! state files (`state`) → `build` → `session`.
+//! formats (`obj`, `ply`, `mesh_file`, `patches`, `texture_file`, `image`), render
+//! state files (`state`) and the denoiser (`denoise`) → `build` → `session`.
 
 // `!(x > 0.0)` is used on purpose: unlike `x <= 0.0` it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -23,6 +23,7 @@ pub mod desc;
 
 pub mod cse167;
 
+pub mod denoise;
 pub mod image;
 pub mod mesh_file;
 pub mod obj;

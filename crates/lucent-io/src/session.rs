@@ -9,7 +9,7 @@ use std::time::Instant;
 use lucent_core::accel::AccelKind;
 use lucent_core::film::Film;
 use lucent_core::render::job::RenderJob;
-use lucent_core::render::{render, RenderControl, RenderStats};
+use lucent_core::render::{render_after, RenderControl, RenderStats};
 
 use crate::build::{build, BuildOptions, Built};
 use crate::cse167::{parse_bytes_with, parse_file_with, ParseOptions};
@@ -143,8 +143,21 @@ impl Renderer {
         progress: &(dyn Fn(u64) + Sync),
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats)> {
+        self.render_after(built, job, None, progress, cancel)
+    }
+
+    /// [`Renderer::render`], continuing `earlier`: the film of the job's pixels' samples
+    /// before `job.samples` ([`render_after`]).
+    pub fn render_after(
+        &self,
+        built: &Built,
+        job: &RenderJob,
+        earlier: Option<&Film>,
+        progress: &(dyn Fn(u64) + Sync),
+        cancel: &AtomicBool,
+    ) -> Option<(Film, RenderStats)> {
         let control = RenderControl { progress, cancel };
         self.pool
-            .install(|| render(&built.scene, built.integrator.as_ref(), job, &control))
+            .install(|| render_after(&built.scene, built.integrator.as_ref(), job, earlier, &control))
     }
 }

@@ -6,7 +6,7 @@
 //! The format (docs/long-renders.md): a text header of `key value` lines —
 //!
 //! ```text
-//! lucent-state 1
+//! lucent-state 2
 //! scene 9f3a…            (a 64-bit hash of the scene's text, every file of it)
 //! name scene.test        (the scene file's name, for people: not compared)
 //! resolution 640 480
@@ -17,17 +17,22 @@
 //! sampler sobol
 //! pixelsampling uniform  (where samples go in a pixel: uniform or stratified)
 //! gamma 3f800000         (the f32 bits of the output encoding's gamma)
+//! aovs yes               (whether the auxiliary passes are kept: yes or no)
+//! noisethreshold none    (adaptive sampling's threshold, f32 bits, or none)
 //! data
 //! ```
 //!
 //! — then, for every pixel of the rectangle row by row, its three sums (i128, little
-//! endian: fixed point with 64 fractional bits, [`ExactSum`]) and its sample count (u32),
-//! and last a 64-bit FNV-1a checksum of those bytes. Files are written whole or not at
+//! endian: fixed point with 64 fractional bits, [`ExactSum`]) and its sample count (u32);
+//! with `aovs yes` the sums of its albedo (3 × i128), normal (3 × i128) and depth (i128)
+//! and the number of samples that hit a surface (u32); with a noise threshold adaptive
+//! sampling's sums of luminance and its square (2 × f64) and whether the pixel has
+//! stopped (one byte, 0 or 1). Last comes a 64-bit FNV-1a checksum of those bytes. Files are written whole or not at
 //! all (a temporary file renamed), and a file whose checksum does not match is refused.
 
 use std::ops::Range;
 
-use lucent_core::film::{ExactSum, Film};
+use lucent_core::film::{AovSum, ExactSum, Film, PixelNoise};
 use lucent_core::render::job::PixelRect;
 
 use crate::fnv::{fnv1a, START as FNV_START};
@@ -57,17 +62,32 @@ pub struct StateHeader {
     /// `stratified` (the ray tracer: sample positions depend on spp).
     pub pixel_sampling: String,
     pub gamma: f32,
+    /// Whether the auxiliary passes are kept (`--aov`, `--denoise`).
+    pub aovs: bool,
+    /// Adaptive sampling's threshold, if the render samples adaptively.
+    pub noise_threshold: Option<f32>,
 }
 
-const MAGIC: &str = "lucent-state 1";
-const PIXEL_BYTES: usize = 3 * 16 + 4;
+const MAGIC: &str = "lucent-state 2";
+const BEAUTY_BYTES: usize = 3 * 16 + 4;
+const AOV_BYTES: usize = 7 * 16 + 4;
+const NOISE_BYTES: usize = 2 * 8 + 1;
+
+impl StateHeader {
+    /// The bytes of one pixel's data.
+    fn pixel_bytes(&self) -> usize {
+        BEAUTY_BYTES
+            + if self.aovs { AOV_BYTES } else { 0 }
+            + if self.noise_threshold.is_some() { NOISE_BYTES } else { 0 }
+    }
+}
 
 impl RenderState {
     pub fn encode(&self) -> Vec<u8> {
         let h = &self.header;
         let p = h.pixels;
         let mut out = format!(
-            "{MAGIC}\nscene {:016x}\nname {}\nresolution {} {}\npixels {} {} {} {}\nspp {}\nsamples {} {}\nseed {}\nsampler {}\npixelsampling {}\ngamma {:08x}\ndata\n",
+            "{MAGIC}\nscene {:016x}\nname {}\nresolution {} {}\npixels {} {} {} {}\nspp {}\nsamples {} {}\nseed {}\nsampler {}\npixelsampling {}\ngamma {:08x}\naovs {}\nnoisethreshold {}\ndata\n",
             h.scene_hash,
             h.scene_name.replace('\n', " "),
             h.resolution.0,
@@ -82,16 +102,42 @@ impl RenderState {
             h.seed,
             h.sampler,
             h.pixel_sampling,
-            h.gamma.to_bits()
+            h.gamma.to_bits(),
+            if h.aovs { "yes" } else { "no" },
+            h.noise_threshold.map_or("none".to_string(), |t| format!("{:08x}", t.to_bits()))
         )
         .into_bytes();
         let start = out.len();
-        out.reserve(self.film.sums.len() * PIXEL_BYTES + 8);
-        for (s, &n) in self.film.sums.iter().zip(&self.film.counts) {
-            for v in s.0 {
+        let f = &self.film;
+        assert_eq!(
+            f.aovs.is_some(),
+            h.aovs,
+            "a film whose passes its header does not describe"
+        );
+        assert_eq!(
+            f.noise.is_some(),
+            h.noise_threshold.is_some(),
+            "a film whose sampling its header does not describe"
+        );
+        out.reserve(f.sums.len() * h.pixel_bytes() + 8);
+        for k in 0..f.sums.len() {
+            for v in f.sums[k].0 {
                 out.extend(v.to_le_bytes());
             }
-            out.extend(n.to_le_bytes());
+            out.extend(f.counts[k].to_le_bytes());
+            if let Some(aovs) = &f.aovs {
+                let a = &aovs[k];
+                for v in a.albedo.0.iter().chain(&a.normal.0).chain([&a.depth]) {
+                    out.extend(v.to_le_bytes());
+                }
+                out.extend(a.hits.to_le_bytes());
+            }
+            if let Some(noise) = &f.noise {
+                let p = &noise[k];
+                out.extend(p.sum.to_bits().to_le_bytes());
+                out.extend(p.sum_sq.to_bits().to_le_bytes());
+                out.push(p.stopped as u8);
+            }
         }
         let sum = fnv1a(&out[start..], FNV_START);
         out.extend(sum.to_le_bytes());
@@ -112,8 +158,14 @@ impl RenderState {
             std::str::from_utf8(&rest[..end])
                 .map_err(|_| "not a lucent state file (its header is not text)".to_string())
         };
-        if line()? != MAGIC {
-            return Err(format!("not a lucent state file (it does not start with '{MAGIC}')"));
+        match line()? {
+            MAGIC => {}
+            l if l.starts_with("lucent-state ") => {
+                return Err(format!(
+                    "a state file of another version of lucent ('{l}'; this one reads '{MAGIC}')"
+                ))
+            }
+            _ => return Err(format!("not a lucent state file (it does not start with '{MAGIC}')")),
         }
         // `count` values after the key; `usize::MAX`: the rest of the line as one value.
         let mut field = |key: &str, count: usize| -> Result<Vec<String>, String> {
@@ -164,6 +216,17 @@ impl RenderState {
         let g = field("gamma", 1)?;
         let gamma =
             f32::from_bits(u32::from_str_radix(&g[0], 16).map_err(|_| "the header's gamma is not hexadecimal")?);
+        let aovs = match field("aovs", 1)?[0].as_str() {
+            "yes" => true,
+            "no" => false,
+            other => return Err(format!("the header's aovs '{other}' is not yes or no")),
+        };
+        let noise_threshold = match field("noisethreshold", 1)?.remove(0) {
+            t if t == "none" => None,
+            t => Some(f32::from_bits(
+                u32::from_str_radix(&t, 16).map_err(|_| "the header's noise threshold is not hexadecimal")?,
+            )),
+        };
         field("data", 0)?;
         if !(pixels.x0 < pixels.x1 && pixels.y0 < pixels.y1 && pixels.x1 <= resolution.0 && pixels.y1 <= resolution.1) {
             return Err("the header's pixels are not a rectangle inside its resolution".into());
@@ -171,41 +234,71 @@ impl RenderState {
         if !(samples.start < samples.end && samples.end <= spp) {
             return Err("the header's samples are not a range within its spp".into());
         }
+        let header = StateHeader {
+            scene_hash,
+            scene_name,
+            resolution,
+            pixels,
+            spp,
+            samples,
+            seed,
+            sampler,
+            pixel_sampling,
+            gamma,
+            aovs,
+            noise_threshold,
+        };
         let n = pixels.pixels() as usize;
+        let size = header.pixel_bytes();
         let data = &bytes[pos..];
-        if data.len() != n * PIXEL_BYTES + 8 {
+        let needed = n.checked_mul(size).and_then(|b| b.checked_add(8));
+        if needed != Some(data.len()) {
             return Err(format!(
                 "{} bytes of pixel data where {} pixels need {} (a file cut short?)",
                 data.len(),
                 n,
-                n * PIXEL_BYTES + 8
+                needed.map_or("more than any file holds".to_string(), |b| b.to_string())
             ));
         }
-        let (body, check) = data.split_at(n * PIXEL_BYTES);
+        let (body, check) = data.split_at(n * size);
         if fnv1a(body, FNV_START).to_le_bytes() != check {
             return Err("its pixel data does not match its checksum (a damaged file)".into());
         }
-        let mut film = Film::new(pixels.width(), pixels.height());
-        for (k, px) in body.chunks_exact(PIXEL_BYTES).enumerate() {
-            let i = |j: usize| i128::from_le_bytes(px[16 * j..16 * j + 16].try_into().unwrap());
-            film.sums[k] = ExactSum([i(0), i(1), i(2)]);
-            film.counts[k] = u32::from_le_bytes(px[48..52].try_into().unwrap());
+        let mut film = Film::with_aovs(pixels.width(), pixels.height(), aovs);
+        if noise_threshold.is_some() {
+            film.noise = Some(vec![PixelNoise::default(); n]);
         }
-        Ok(RenderState {
-            header: StateHeader {
-                scene_hash,
-                scene_name,
-                resolution,
-                pixels,
-                spp,
-                samples,
-                seed,
-                sampler,
-                pixel_sampling,
-                gamma,
-            },
-            film,
-        })
+        for (k, px) in body.chunks_exact(size).enumerate() {
+            let i = |j: usize| i128::from_le_bytes(px[16 * j..16 * j + 16].try_into().unwrap());
+            let u = |at: usize| u32::from_le_bytes(px[at..at + 4].try_into().unwrap());
+            film.sums[k] = ExactSum([i(0), i(1), i(2)]);
+            film.counts[k] = u(48);
+            let mut at = BEAUTY_BYTES;
+            if let Some(aovs) = &mut film.aovs {
+                let a = &px[at..];
+                let i = |j: usize| i128::from_le_bytes(a[16 * j..16 * j + 16].try_into().unwrap());
+                aovs[k] = AovSum {
+                    albedo: ExactSum([i(0), i(1), i(2)]),
+                    normal: ExactSum([i(3), i(4), i(5)]),
+                    depth: i(6),
+                    hits: u(at + 112),
+                };
+                at += AOV_BYTES;
+            }
+            if let Some(noise) = &mut film.noise {
+                let f = |at: usize| f64::from_bits(u64::from_le_bytes(px[at..at + 8].try_into().unwrap()));
+                noise[k] = PixelNoise {
+                    sum: f(at),
+                    sum_sq: f(at + 8),
+                    stopped: match px[at + 16] {
+                        0 => false,
+                        1 => true,
+                        _ => return Err("its pixel data is not what a state file holds (a damaged file)".into()),
+                    },
+                };
+            }
+        }
+        Ok(RenderState { header, film })
     }
 }
 
@@ -266,6 +359,11 @@ impl StateHeader {
                 "integrator's pixel sampling",
             ),
             (self.gamma.to_bits() != other.gamma.to_bits(), "gamma"),
+            (self.aovs != other.aovs, "set of passes (AOVs)"),
+            (
+                self.noise_threshold.map(f32::to_bits) != other.noise_threshold.map(f32::to_bits),
+                "noise threshold",
+            ),
         ];
         differs.iter().find(|(d, _)| *d).map(|(_, what)| *what)
     }
@@ -307,7 +405,22 @@ pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, St
     };
     let range = states.iter().map(|s| s.header.samples.start).min().unwrap()
         ..states.iter().map(|s| s.header.samples.end).max().unwrap();
-    let mut film = Film::new(union.width(), union.height());
+    if first.header.noise_threshold.is_some() {
+        for i in 0..states.len() {
+            for j in i + 1..states.len() {
+                if overlap(&states[i].header.pixels, &states[j].header.pixels) {
+                    return Err(format!(
+                        "{} and {} hold samples of the same pixels of an adaptive render: sample ranges of adaptive sampling follow from each other, so continue such a render with --resume instead of merging its ranges",
+                        names[i], names[j]
+                    ));
+                }
+            }
+        }
+    }
+    let mut film = Film::with_aovs(union.width(), union.height(), first.header.aovs);
+    if first.header.noise_threshold.is_some() {
+        film.noise = Some(vec![PixelNoise::default(); film.counts.len()]);
+    }
     // How many sample indices cover each pixel: with no overlaps, all of `range` exactly
     // when it is the range's length.
     let mut covered = vec![0u32; film.counts.len()];
@@ -319,7 +432,11 @@ pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, St
             for x in 0..p.width() {
                 let src = (y * p.width() + x) as usize;
                 let dst = (p.y0 - union.y0 + y) as usize * w + (p.x0 - union.x0 + x) as usize;
-                film.add(dst, &s.film.sums[src], s.film.counts[src]);
+                let aov = s.film.aovs.as_ref().map_or(AovSum::default(), |a| a[src]);
+                film.add(dst, &s.film.sums[src], s.film.counts[src], &aov);
+                if let (Some(to), Some(from)) = (&mut film.noise, &s.film.noise) {
+                    to[dst] = from[src];
+                }
                 covered[dst] += len;
             }
         }
@@ -368,6 +485,8 @@ mod tests {
                 sampler: "sobol".into(),
                 pixel_sampling: "uniform".into(),
                 gamma: 2.2,
+                aovs: false,
+                noise_threshold: None,
             },
             film,
         }
@@ -390,6 +509,50 @@ mod tests {
         assert!(RenderState::decode(b"P6\n")
             .unwrap_err()
             .contains("not a lucent state file"));
+        assert!(RenderState::decode(b"lucent-state 1\n")
+            .unwrap_err()
+            .contains("another version"));
+    }
+
+    #[test]
+    fn auxiliary_passes_and_adaptive_estimates_survive_a_round_trip() {
+        let mut s = state(rect(0, 3, 1, 3), 0..16);
+        s.header.aovs = true;
+        s.header.noise_threshold = Some(0.05);
+        let n = s.film.counts.len();
+        s.film.aovs = Some(
+            (0..n)
+                .map(|k| {
+                    let mut a = AovSum::default();
+                    a.add_sample(&lucent_core::film::AovSample {
+                        albedo: Color::splat(0.1 * k as f32),
+                        normal: lucent_core::math::Vec3A::new(0.0, -1.0, 0.0),
+                        depth: (k % 2 == 0).then_some(2.5 + k as f32),
+                    });
+                    a
+                })
+                .collect(),
+        );
+        s.film.noise = Some(
+            (0..n)
+                .map(|k| PixelNoise {
+                    sum: k as f64 / 3.0,
+                    sum_sq: k as f64 / 7.0,
+                    stopped: k % 3 == 0,
+                })
+                .collect(),
+        );
+        let back = RenderState::decode(&s.encode()).unwrap();
+        assert_eq!(back, s);
+        // Parts of an adaptive render that share pixels do not merge.
+        let mut a = state(rect(0, 4, 0, 4), 0..8);
+        let mut b = state(rect(0, 4, 0, 4), 8..16);
+        for p in [&mut a, &mut b] {
+            p.header.noise_threshold = Some(0.05);
+            p.film.noise = Some(vec![PixelNoise::default(); 16]);
+        }
+        let names = ["a".to_string(), "b".to_string()];
+        assert!(merge(&[a, b], &names).unwrap_err().contains("--resume"));
     }
 
     #[test]

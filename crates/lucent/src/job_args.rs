@@ -86,7 +86,16 @@ pub fn resume(path: &std::path::Path, job: &mut RenderJob, now: &StateHeader) ->
     let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
     let state = RenderState::decode(&bytes)?;
     let h = &state.header;
-    if let Some(what) = h.difference(now, false) {
+    // The passes the state keeps are continued whether or not they are asked for again.
+    if job.aovs && !h.aovs {
+        return Err("it keeps no auxiliary passes, which --aov and --denoise need (render it with --aov or --denoise to keep them)".into());
+    }
+    job.aovs = h.aovs;
+    let now = StateHeader {
+        aovs: h.aovs,
+        ..now.clone()
+    };
+    if let Some(what) = h.difference(&now, false) {
         let why = match what {
             "scene" => "the scene's text has changed".to_string(),
             _ => format!("the {what} differs"),

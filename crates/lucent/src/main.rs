@@ -2,6 +2,7 @@
 //! and says what it holds, `diff` compares two images, `merge` puts render states
 //! together, `bench` measures speed.
 
+mod aov_args;
 mod bench;
 mod check;
 mod diff;
@@ -11,6 +12,7 @@ mod oom;
 mod output;
 mod partial;
 mod passes;
+mod picture;
 mod progress;
 mod render;
 mod settings_args;

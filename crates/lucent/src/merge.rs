@@ -1,4 +1,4 @@
-//! `lucent merge A.lstate B.lstate … -o OUT.png|OUT.exr|OUT.hdr [--state OUT.lstate]`:
+//! `lucent merge A.lstate B.lstate … -o OUT.png|OUT.exr|OUT.hdr [--state OUT.lstate] [--aov …] [--denoise] [--threads N]`:
 //! the render that states of regions and sample ranges of one scene make together — the
 //! bytes of rendering it in one go. Inputs of another scene or other options, overlaps
 //! and gaps are refused with a message that names the files.
@@ -11,7 +11,9 @@ use lucent_io::diag::Diagnostics;
 use lucent_io::resources::OutputTarget;
 use lucent_io::state::{merge, RenderState};
 
-use crate::output::{choose_output, write_image};
+use crate::aov_args::{parse_aovs, AovSelection};
+use crate::output::choose_output;
+use crate::picture::{aov_file, write_picture, Extras};
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
@@ -25,9 +27,35 @@ pub struct MergeArgs {
     /// Also write the merged state (to merge further or resume).
     #[arg(long, value_name = "OUT.lstate")]
     pub state: Option<PathBuf>,
+    /// Write these auxiliary passes too (the states must keep them: rendered with --aov
+    /// or --denoise), as `lucent render --aov`.
+    #[arg(long, value_name = "albedo,normal,depth,alpha", value_parser = parse_aovs)]
+    pub aov: Option<AovSelection>,
+    /// Denoise the merged colour with Intel Open Image Denoise (the states must keep the
+    /// passes), as `lucent render --denoise`.
+    #[arg(long)]
+    pub denoise: bool,
+    /// Threads for the denoiser (default: all cores).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
 }
 
 pub fn run(args: &MergeArgs) -> u8 {
+    let denoiser = match args.denoise.then(lucent_io::denoise::Denoiser::load).transpose() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let extras = Extras {
+        aovs: args.aov.unwrap_or_default(),
+        denoiser: denoiser.as_ref(),
+        threads: args.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |n| n as usize,
+        ),
+    };
     let names: Vec<String> = args.inputs.iter().map(|p| p.display().to_string()).collect();
     let mut states = Vec::with_capacity(args.inputs.len());
     for (path, name) in args.inputs.iter().zip(&names) {
@@ -57,7 +85,15 @@ pub fn run(args: &MergeArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
-    if let Err(e) = write_image(&out, &merged.film.resolve(), &crate::output::image_info(&merged.header)) {
+    if extras.need_aovs() && !merged.header.aovs {
+        eprintln!("lucent: error: --aov and --denoise need the auxiliary passes, and these states keep none: render them with --aov or --denoise");
+        return EXIT_BAD_INPUT;
+    }
+    if let Err(e) = aov_file(&out, extras.aovs) {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
+    }
+    if let Err(e) = write_picture(&out, &merged.film, &merged.header, &extras) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }

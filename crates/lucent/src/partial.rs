@@ -9,6 +9,7 @@ use lucent_io::resources::OutputTarget;
 use lucent_io::state::{RenderState, StateHeader};
 
 use crate::output::Output;
+use crate::picture::Extras;
 
 /// Where a partial render goes: `OUT.partial.EXT` beside the output (nothing for standard
 /// output or a device) and the state at `--state`, else `OUT.partial.lstate`.
@@ -56,10 +57,11 @@ impl Partial {
         self.state.0.display().to_string()
     }
 
-    /// Writes the partial image and the state (each atomically).
-    pub fn write(&self, film: &Film, header: StateHeader) -> Result<(), String> {
+    /// Writes the partial image (with the passes and denoising of `extras`) and the
+    /// state (each atomically).
+    pub fn write(&self, film: &Film, header: StateHeader, extras: &Extras) -> Result<(), String> {
         if let Some(img) = &self.image {
-            crate::output::write_image(img, &film.resolve(), &crate::output::image_info(&header))?;
+            crate::picture::write_picture(img, film, &header, extras)?;
         }
         let state = RenderState {
             header,
@@ -72,9 +74,12 @@ impl Partial {
 
     /// Removes what checkpoints wrote, once the render is complete (the state at
     /// `--state` is the final one by then, and stays).
-    pub fn remove(&self) {
+    pub fn remove(&self, extras: &Extras) {
         if let Some(img) = &self.image {
             let _ = std::fs::remove_file(&img.name);
+            if let Ok(Some(side)) = crate::picture::aov_file(img, extras.aovs) {
+                let _ = std::fs::remove_file(&side.name);
+            }
         }
         if self.state.1 {
             let _ = std::fs::remove_file(&self.state.0);

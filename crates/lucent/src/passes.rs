@@ -6,8 +6,8 @@
 //!
 //! The first pass is one sample; later ones are sized from the time a sample took, to
 //! last about an eighth of the time spent so far (at least 2 s, at most the checkpoint
-//! interval or a minute). Adaptive sampling runs as one pass: its decisions need every
-//! sample of a pixel at once.
+//! interval or a minute). Adaptive sampling carries each pixel's estimate from pass to
+//! pass in the film, so its decisions are those of one pass too.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -45,16 +45,12 @@ pub fn render_in_passes(
     save: &mut dyn FnMut(&Film, &Range<u32>),
 ) -> Outcome {
     let rect = job.pixels;
-    let mut film = start.unwrap_or_else(|| Film::new(rect.width(), rect.height()));
+    let mut film = start.unwrap_or_else(|| Film::with_aovs(rect.width(), rect.height(), job.aovs));
     let mut stats: Option<RenderStats> = None;
     let began = Instant::now();
     let mut last_save = Instant::now();
     let mut done = job.samples.start;
-    let mut size = if job.noise_threshold.is_some() {
-        job.samples.len() as u32
-    } else {
-        1
-    };
+    let mut size = 1;
     while done < job.samples.end {
         let pass = done..(done + size).min(job.samples.end);
         let pass_job = RenderJob {
@@ -62,16 +58,14 @@ pub fn render_in_passes(
             ..job.clone()
         };
         let t = Instant::now();
-        let Some((f, s)) = renderer.render(built, &pass_job, progress, cancel) else {
+        let Some((f, s)) = renderer.render_after(built, &pass_job, Some(&film), progress, cancel) else {
             break;
         };
         if cancel.load(Ordering::Relaxed) {
             break;
         }
         let took = t.elapsed().as_secs_f64();
-        for (i, (sum, &n)) in f.sums.iter().zip(&f.counts).enumerate() {
-            film.add(i, sum, n);
-        }
+        film.add_film(&f);
         match &mut stats {
             Some(total) => total.add(&s),
             None => stats = Some(s),

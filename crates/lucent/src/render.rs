@@ -1,4 +1,4 @@
-//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--noise-threshold T] [--spp-map FILE] [--crop X0 X1 Y0 Y1 | --pixel-bounds X0 X1 Y0 Y1] [--samples FIRST..LAST] [--seed N] [--state OUT.lstate] [--resume STATE] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]
+//! `lucent render SCENE [-o OUT.png] [--spp N] [--sampler independent|sobol] [--noise-threshold T] [--spp-map FILE] [--crop X0 X1 Y0 Y1 | --pixel-bounds X0 X1 Y0 Y1] [--samples FIRST..LAST] [--seed N] [--state OUT.lstate] [--resume STATE] [--aov albedo,normal,depth,alpha] [--denoise] [--threads N] [--accel bvh|list] [--strict] [--quiet] [--stats]
 //!
 //! A render of part of the image (a region), of some sample indices or continued from a
 //! state file gives exactly the pixels of the one-go render: merged (`lucent merge`) the
@@ -21,10 +21,12 @@ use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::session::{Renderer, Session, SessionOptions};
 use lucent_io::state::{RenderState, StateHeader};
 
+use crate::aov_args::{parse_aovs, AovSelection};
 use crate::job_args::{apply_samples, parse_samples, pixel_rect, resume};
 use crate::output::{choose_output, report};
 use crate::partial::Partial;
 use crate::passes::{render_in_passes, Outcome};
+use crate::picture::{aov_file, write_picture, Extras};
 use crate::progress::{Finish, Progress};
 use crate::settings_args::{overrides, quick};
 use crate::signals;
@@ -88,6 +90,16 @@ pub struct RenderArgs {
     /// not at all; they are removed when the render completes.
     #[arg(long, value_name = "SECS", value_parser = parse_seconds)]
     pub checkpoint: Option<f64>,
+    /// Also write these auxiliary passes of the first surface each sample sees: as layers
+    /// of the EXR output (albedo.R/G/B, normal.X/Y/Z, depth.Z, alpha as A), or beside a
+    /// PNG/JPEG/HDR output in OUT.aovs.exr.
+    #[arg(long, value_name = "albedo,normal,depth,alpha", value_parser = parse_aovs)]
+    pub aov: Option<AovSelection>,
+    /// Denoise the colour with Intel Open Image Denoise, guided by the albedo and normal
+    /// passes (the library is loaded at run time: scripts/install_oidn.sh installs it, or
+    /// set OIDN_LIB). An EXR output keeps the colour before denoising as noisy.R/G/B.
+    #[arg(long)]
+    pub denoise: bool,
     /// Override a scene setting, as Mitsuba's -D: `-D spp=64`, `-D integrator=pathtracer`,
     /// `-D size=320,240` (commas or spaces between values); repeatable, the last wins.
     #[arg(short = 'D', value_name = "NAME=VALUE", action = clap::ArgAction::Append)]
@@ -241,6 +253,21 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         },
         None => None,
     };
+    let aov_side = match aov_file(&out, args.aov.unwrap_or_default()) {
+        Ok(side) => side,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    // A missing denoiser is found now, not after hours of rendering.
+    let denoiser = match args.denoise.then(lucent_io::denoise::Denoiser::load).transpose() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     let mut named = session.res.inputs.clone();
     for p in session.desc.named_files() {
         if let Ok(meta) = std::fs::metadata(p) {
@@ -254,6 +281,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     }
     let targets = std::iter::once((&out.name, &out.target))
         .chain(spp_map.iter().map(|m| (&m.name, &m.target)))
+        .chain(aov_side.iter().map(|m| (&m.name, &m.target)))
         .chain(state_out.iter().map(|(n, t)| (n, t)));
     for (name, target) in targets {
         if let Err(e) = target.check_not_input(&named) {
@@ -274,7 +302,13 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         Ok(r) => r,
         Err(code) => return code,
     };
+    let extras = Extras {
+        aovs: args.aov.unwrap_or_default(),
+        denoiser: denoiser.as_ref(),
+        threads: renderer.threads(),
+    };
     let mut job = built.job();
+    job.aovs = extras.need_aovs();
     if let Some(spp) = args.spp {
         job.spp = spp;
         job.samples = 0..spp;
@@ -317,6 +351,8 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             .to_string(),
         pixel_sampling: pixel_sampling.to_string(),
         gamma: built.settings.gamma,
+        aovs: job.aovs,
+        noise_threshold: job.noise_threshold,
     };
     let (w, h) = (job.resolution.width, job.resolution.height);
     let part = pixel_rect(args.crop.as_deref(), args.pixel_bounds.as_deref(), w, h)
@@ -327,9 +363,8 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             args.samples.as_ref().map_or(Ok(()), |s| apply_samples(&mut job, s))
         })
         .and_then(|()| {
-            let split = args.samples.is_some() || args.resume.is_some() || args.state.is_some();
-            if job.noise_threshold.is_some() && split {
-                return Err("adaptive sampling (--noise-threshold, noisethreshold) cannot be split into sample ranges, resumed or kept in a state file yet".into());
+            if job.noise_threshold.is_some() && job.samples.start > 0 {
+                return Err("with adaptive sampling (--noise-threshold, noisethreshold) a sample range must start at 0: where each pixel stops depends on its earlier samples, so render the first range and continue it with --resume".into());
             }
             Ok(())
         });
@@ -361,7 +396,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
             samples: samples.clone(),
             ..header(&job)
         };
-        match partial.write(film, kept) {
+        match partial.write(film, kept, &extras) {
             Ok(()) => wrote_partial = true,
             Err(e) => eprintln!("lucent: warning: checkpoint not written: {e}"),
         }
@@ -401,7 +436,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
                     job.spp - 1
                 )
             };
-            match partial.write(&film, kept) {
+            match partial.write(&film, kept, &extras) {
                 Ok(()) => eprintln!(
                     "lucent: interrupted after samples {}..{} of every pixel: wrote {} and {}; {how}",
                     samples.start,
@@ -457,7 +492,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     let writing = Progress::phase("writing", args.quiet);
     let _done_writing = Finish(&writing);
     let info = crate::output::image_info(&kept);
-    if let Err(e) = crate::output::write_image(&out, &film.resolve(), &info) {
+    if let Err(e) = write_picture(&out, &film, &kept, &extras) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
@@ -493,7 +528,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         }
     }
     if wrote_partial {
-        partial.remove();
+        partial.remove(&extras);
     }
     writing.finish();
     let t_written = Instant::now();
@@ -518,12 +553,14 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         eprintln!("lucent: {warnings} warning{s} (see above)");
     }
     if job.noise_threshold.is_some() && !args.quiet {
+        // From the film: with --resume it holds the earlier samples too.
+        let counts = &film.counts;
         eprintln!(
             "adaptive sampling: {:.1} samples per pixel on average (min {}, max {}, cap {})",
-            stats.samples as f64 / film.counts.len().max(1) as f64,
-            stats.min_pixel_samples,
-            stats.max_pixel_samples,
-            job.samples.len()
+            counts.iter().map(|&n| n as f64).sum::<f64>() / counts.len().max(1) as f64,
+            counts.iter().min().copied().unwrap_or(0),
+            counts.iter().max().copied().unwrap_or(0),
+            job.samples.end - first
         );
     }
     if args.stats {

@@ -62,6 +62,9 @@ pub struct RenderJob {
     /// below this, after at least [`MIN_ADAPTIVE_SAMPLES`] (or all of them); `None`
     /// takes every sample.
     pub noise_threshold: Option<f32>,
+    /// Also compute the auxiliary passes (albedo, normal, depth, alpha) of every sample
+    /// ([`super::aov`]).
+    pub aovs: bool,
 }
 
 /// The fewest samples a pixel takes before adaptive sampling may stop it: fewer do not
@@ -80,6 +83,7 @@ impl RenderJob {
             seed: 0,
             sampler: SamplerKind::Independent,
             noise_threshold: None,
+            aovs: false,
         }
     }
 

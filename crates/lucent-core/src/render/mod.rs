@@ -11,15 +11,16 @@
 //!
 //! [`Camera::ray`]: crate::camera::Camera::ray
 
+pub mod aov;
 pub mod job;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
-use crate::film::{ExactSum, Film};
+use crate::film::{AovSum, ExactSum, Film, PixelNoise};
 use crate::integrator::{Integrator, PixelSampling, TraceCounts};
-use crate::math::{Color, DVec3};
+use crate::math::Color;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
 use job::{RenderJob, MIN_ADAPTIVE_SAMPLES};
@@ -104,8 +105,18 @@ pub struct RenderControl<'a> {
     pub cancel: &'a AtomicBool,
 }
 
-/// A tile's pixels, row by row: the sum of each one's samples and how many it took.
-type TilePixels = Vec<(ExactSum, u32)>;
+/// What a pixel's samples add to the film.
+struct PixelResult {
+    sum: ExactSum,
+    taken: u32,
+    /// The sums of their auxiliary passes (zero when the job does not ask for them).
+    aov: AovSum,
+    /// Adaptive sampling's estimate after them (default without a noise threshold).
+    noise: PixelNoise,
+}
+
+/// A tile's pixels, row by row.
+type TilePixels = Vec<PixelResult>;
 
 struct Tile {
     x0: u32,
@@ -125,8 +136,31 @@ pub fn render(
     job: &RenderJob,
     control: &RenderControl,
 ) -> Option<(Film, RenderStats)> {
+    render_after(scene, integrator, job, None, control)
+}
+
+/// [`render`], continuing `earlier`, the film of the same pixels' samples before
+/// `job.samples` (adaptive sampling goes on from its estimates: a pixel that stopped
+/// there takes no sample here).
+///
+/// # Panics
+/// If the job is not valid, or `earlier` is not a film of its pixels.
+pub fn render_after(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    job: &RenderJob,
+    earlier: Option<&Film>,
+    control: &RenderControl,
+) -> Option<(Film, RenderStats)> {
     if let Err(e) = job.check() {
         panic!("render: {e}");
+    }
+    if let Some(f) = earlier {
+        assert_eq!(
+            (f.width, f.height),
+            (job.pixels.width(), job.pixels.height()),
+            "render: an earlier film of other pixels"
+        );
     }
     let rect = job.pixels;
     // Tiles of the whole image's grid, clipped to the rectangle.
@@ -152,14 +186,17 @@ pub fn render(
             if control.cancel.load(Ordering::Relaxed) {
                 return None;
             }
-            let out = render_tile(scene, integrator, job, &tiles[t as usize], control.cancel)?;
+            let out = render_tile(scene, integrator, job, earlier, &tiles[t as usize], control.cancel)?;
             (control.progress)(out.0.len() as u64 * job.samples.len() as u64);
             Some(out)
         })
         .collect();
 
     let w = rect.width() as usize;
-    let mut film = Film::new(rect.width(), rect.height());
+    let mut film = Film::with_aovs(rect.width(), rect.height(), job.aovs);
+    if job.noise_threshold.is_some() {
+        film.noise = Some(vec![PixelNoise::default(); film.counts.len()]);
+    }
     let mut stats = RenderStats {
         min_pixel_samples: u32::MAX,
         ..RenderStats::default()
@@ -171,8 +208,11 @@ pub fn render(
         let tw = (tile.x1 - tile.x0) as usize;
         for (row, chunk) in pixels.chunks(tw).enumerate() {
             let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
-            for (i, (sum, taken)) in chunk.iter().enumerate() {
-                film.add(start + i, sum, *taken);
+            for (i, p) in chunk.iter().enumerate() {
+                film.add(start + i, &p.sum, p.taken, &p.aov);
+                if let Some(noise) = &mut film.noise {
+                    noise[start + i] = p.noise;
+                }
             }
         }
     }
@@ -185,6 +225,7 @@ fn render_tile(
     scene: &Scene,
     integrator: &dyn Integrator,
     job: &RenderJob,
+    earlier: Option<&Film>,
     tile: &Tile,
     cancel: &AtomicBool,
 ) -> Option<(TilePixels, RenderStats)> {
@@ -205,9 +246,18 @@ fn render_tile(
                 lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
             }
             let mut sum = ExactSum::default();
-            let mut noise = NoiseEstimate::default();
+            let mut aov = AovSum::default();
             let mut taken = 0u32;
-            for i in job.samples.clone() {
+            // Adaptive sampling goes on from the earlier samples' estimate.
+            let (mut noise, before) = match earlier {
+                Some(f) => {
+                    let k = (y - job.pixels.y0) as usize * job.pixels.width() as usize + (x - job.pixels.x0) as usize;
+                    (f.noise.as_ref().map_or(PixelNoise::default(), |n| n[k]), f.counts[k])
+                }
+                None => (PixelNoise::default(), 0),
+            };
+            let samples = if noise.stopped { 0..0 } else { job.samples.clone() };
+            for i in samples {
                 if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
                 }
@@ -245,6 +295,9 @@ fn render_tile(
                 let ray = scene
                     .camera
                     .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
+                if job.aovs {
+                    aov.add_sample(&aov::first_surface(scene, &ray, &mut counts));
+                }
                 let c = integrator.radiance(scene, &ray, &mut sampler, &mut counts);
                 let c = if c.is_finite() {
                     c
@@ -257,18 +310,20 @@ fn render_tile(
                 sum.add_sample(c);
                 taken += 1;
                 if let Some(threshold) = job.noise_threshold {
-                    noise.add(c.as_dvec3());
+                    noise.add(c);
                     // Looked at every 8 samples: a stop then leaves whole 8-point nets of
                     // the Sobol sequences, which cover the pixel evenly.
-                    if taken >= MIN_ADAPTIVE_SAMPLES.min(n)
-                        && taken % 8 == 0
-                        && noise.relative_error() < threshold as f64
+                    let all = before + taken;
+                    if all >= MIN_ADAPTIVE_SAMPLES.min(n)
+                        && all % 8 == 0
+                        && noise.relative_error(all) < threshold as f64
                     {
+                        noise.stopped = true;
                         break;
                     }
                 }
             }
-            pixels.push((sum, taken));
+            pixels.push(PixelResult { sum, taken, aov, noise });
             taken_min = taken_min.min(taken);
             taken_max = taken_max.max(taken);
             taken_all += taken as u64;
@@ -284,37 +339,6 @@ fn render_tile(
         max_pixel_samples: taken_max,
     };
     Some((pixels, stats))
-}
-
-/// The running mean and spread of a pixel's luminance, for adaptive sampling.
-#[derive(Default)]
-struct NoiseEstimate {
-    n: f64,
-    sum: f64,
-    sum_sq: f64,
-}
-
-impl NoiseEstimate {
-    fn add(&mut self, c: DVec3) {
-        // Rec. 709 luminance, on the linear radiance.
-        let y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
-        self.n += 1.0;
-        self.sum += y;
-        self.sum_sq += y * y;
-    }
-
-    /// The standard error of the mean over the mean: 0 for a pixel whose samples are all
-    /// the same (black included), infinite for one with a positive spread and a zero mean.
-    fn relative_error(&self) -> f64 {
-        let mean = self.sum / self.n;
-        let variance = ((self.sum_sq - self.sum * mean) / (self.n - 1.0).max(1.0)).max(0.0);
-        let error = (variance / self.n).sqrt();
-        if error == 0.0 {
-            0.0
-        } else {
-            error / mean.abs()
-        }
-    }
 }
 
 /// `0..n` in an order drawn from the pixel alone (Fisher–Yates), reusing `out`'s storage.

@@ -67,6 +67,18 @@ impl Bsdf {
         }
     }
 
+    /// The colour of the surface for a denoiser's albedo guide: `kd + ks` (at most 1 per
+    /// channel) for the glossy models, the reflectance of a mirror, the transmittance of
+    /// glass.
+    pub fn albedo(&self) -> Color {
+        match self {
+            Bsdf::Phong(b) => (b.kd + b.ks).min(Color::ONE),
+            Bsdf::Ggx(b) => (b.kd + b.ks).min(Color::ONE),
+            Bsdf::Mirror(b) => b.ks.min(Color::ONE),
+            Bsdf::Dielectric(b) => b.kt.min(Color::ONE),
+        }
+    }
+
     /// Whether the BSDF scatters into single directions only (mirror, glass).
     #[inline]
     pub fn is_delta(&self) -> bool {

@@ -1,13 +1,7 @@
-//! The film: per pixel, the sum of its samples' radiance and their count. Sums, not
-//! averages, so that a render can take more samples later and two renders of disjoint
-//! pixels or sample ranges can be merged; [`Film::resolve`] divides them into the
-//! [`Image`] that is written.
-//!
-//! The sums are exact ([`ExactSum`]): adding samples in another grouping — the first 64
-//! here and the next 64 on another machine, merged — gives the very same bits as adding
-//! them one after the other, which floating-point sums would not.
+//! Exact sums of samples: fixed-point numbers whose additions do not depend on their
+//! order or grouping, so that a render cut into parts and merged is the very bits of the
+//! one-go render.
 
-use crate::image::Image;
 use crate::math::{Color, DVec3};
 
 /// A sum of radiance samples that does not depend on the order or grouping of the
@@ -23,9 +17,16 @@ const ONE: f64 = 18_446_744_073_709_551_616.0;
 const LIMIT: f64 = 1_099_511_627_776.0; // 2⁴⁰
 
 impl ExactSum {
+    /// `v` in the fixed point (clamped to ±2⁴⁰).
     #[inline]
-    fn fixed(v: f32) -> i128 {
+    pub fn fixed(v: f32) -> i128 {
         ((v as f64).clamp(-LIMIT, LIMIT) * ONE).round() as i128
+    }
+
+    /// A fixed-point number as f64 (rounded once, to nearest).
+    #[inline]
+    pub fn to_f64(v: i128) -> f64 {
+        v as f64 / ONE
     }
 
     /// Adds one sample (a finite colour).
@@ -50,52 +51,6 @@ impl ExactSum {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct Film {
-    pub width: u32,
-    pub height: u32,
-    /// Row-major, top row first.
-    pub sums: Vec<ExactSum>,
-    pub counts: Vec<u32>,
-}
-
-impl Film {
-    pub fn new(width: u32, height: u32) -> Film {
-        let n = width as usize * height as usize;
-        Film {
-            width,
-            height,
-            sums: vec![ExactSum::default(); n],
-            counts: vec![0; n],
-        }
-    }
-
-    /// Adds a pixel's `count` samples, whose radiance sums to `sum`.
-    #[inline]
-    pub fn add(&mut self, index: usize, sum: &ExactSum, count: u32) {
-        self.sums[index].add(sum);
-        self.counts[index] += count;
-    }
-
-    /// The mean of every pixel's samples (black where there are none).
-    pub fn resolve(&self) -> Image {
-        let pixels = self
-            .sums
-            .iter()
-            .zip(&self.counts)
-            .map(|(s, &n)| match n {
-                0 => Color::ZERO,
-                n => (s.value() / n as f64).as_vec3().into(),
-            })
-            .collect();
-        Image {
-            width: self.width,
-            height: self.height,
-            pixels,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,16 +59,6 @@ mod tests {
         let mut s = ExactSum::default();
         samples.iter().for_each(|&c| s.add_sample(c));
         s
-    }
-
-    #[test]
-    fn sums_resolve_to_means() {
-        let mut f = Film::new(2, 1);
-        f.add(0, &sum_of(&[Color::new(1.0, 2.0, 3.0)]), 1);
-        f.add(0, &sum_of(&[Color::new(1.0, 0.0, 1.0), Color::ZERO, Color::ZERO]), 3);
-        let img = f.resolve();
-        assert_eq!(img.pixels[0], Color::new(0.5, 0.5, 1.0));
-        assert_eq!(img.pixels[1], Color::ZERO);
     }
 
     #[test]

@@ -1,0 +1,150 @@
+//! What a render (or a merge) writes of its film: the colour in the output's format —
+//! denoised with `--denoise` — and the auxiliary passes of `--aov`: layers of the same
+//! file when the output is an EXR (`albedo.R/G/B`, `normal.X/Y/Z`, `depth.Z`, alpha as
+//! `A`, and with `--denoise` the colour before denoising as `noisy.R/G/B`), else an EXR
+//! beside it, `OUT.aovs.exr`, with the colour and those layers.
+
+use std::path::Path;
+
+use lucent_core::film::{AovImages, Film};
+use lucent_core::image::Image;
+use lucent_io::denoise::{DenoiseInput, Denoiser};
+use lucent_io::desc::SceneDesc;
+use lucent_io::diag::Diagnostics;
+use lucent_io::image::encode_exr_channels;
+use lucent_io::resources::OutputTarget;
+use lucent_io::state::StateHeader;
+
+use crate::aov_args::AovSelection;
+use crate::output::{choose_output, image_info, write_image, Format, Output};
+
+/// What is written besides the plain colour.
+#[derive(Clone, Copy)]
+pub struct Extras<'a> {
+    pub aovs: AovSelection,
+    /// The denoiser, with `--denoise`.
+    pub denoiser: Option<&'a Denoiser>,
+    /// The threads the denoiser may use.
+    pub threads: usize,
+}
+
+impl Extras<'_> {
+    /// Whether the film must keep the auxiliary passes.
+    pub fn need_aovs(&self) -> bool {
+        self.aovs.any() || self.denoiser.is_some()
+    }
+}
+
+/// The EXR that holds the passes of a non-EXR output: `OUT.aovs.exr` beside it; `None`
+/// when the output is an EXR itself or no pass is asked for. An error when the output
+/// is standard output or a device (there is no "beside").
+pub fn aov_file(out: &Output, aovs: AovSelection) -> Result<Option<Output>, String> {
+    if !aovs.any() || out.format == Format::Exr {
+        return Ok(None);
+    }
+    if !matches!(out.target, OutputTarget::File(_)) {
+        return Err("--aov writes its passes to a file: name an .exr output with -o (or a file beside which OUT.aovs.exr can go)".into());
+    }
+    let stem = out
+        .name
+        .file_stem()
+        .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+    let name = out.name.with_file_name(format!("{stem}.aovs.exr"));
+    choose_output(
+        Some(Path::new(&name)),
+        &SceneDesc::default(),
+        &mut Diagnostics::default(),
+    )
+    .map(Some)
+}
+
+/// Writes the picture of `film` (described by `header`) to `out`, with `extras`.
+pub fn write_picture(out: &Output, film: &Film, header: &StateHeader, extras: &Extras) -> Result<(), String> {
+    let info = image_info(header);
+    let noisy = film.resolve();
+    let aovs = film.resolve_aovs();
+    let denoised = match extras.denoiser {
+        Some(d) => {
+            let a = aovs.as_ref().expect("a film rendered for denoising keeps its passes");
+            Some(denoise(d, &noisy, a, extras.threads)?)
+        }
+        None => None,
+    };
+    let colour = denoised.as_ref().unwrap_or(&noisy);
+    let layered = |colour: &Image| {
+        let noisy = denoised.is_some().then_some(&noisy);
+        encode_exr_channels(
+            film.width,
+            film.height,
+            channels(colour, noisy, aovs.as_ref(), extras.aovs),
+            &info,
+        )
+    };
+    if out.format == Format::Exr {
+        return layered(colour)
+            .and_then(|b| out.target.write(&b))
+            .map_err(|e| format!("cannot write {}: {e}", out.name.display()));
+    }
+    write_image(out, colour, &info)?;
+    if let Some(side) = aov_file(out, extras.aovs)? {
+        layered(colour)
+            .and_then(|b| side.target.write(&b))
+            .map_err(|e| format!("cannot write {}: {e}", side.name.display()))?;
+    }
+    Ok(())
+}
+
+/// The colour through Open Image Denoise, guided by the albedo and normal passes.
+fn denoise(d: &Denoiser, noisy: &Image, aovs: &AovImages, threads: usize) -> Result<Image, String> {
+    let input = DenoiseInput {
+        width: noisy.width,
+        height: noisy.height,
+        color: &noisy.to_rgb_f32(),
+        albedo: &aovs.albedo.to_rgb_f32(),
+        normal: &aovs.normal.to_rgb_f32(),
+    };
+    let out = d.denoise(&input, threads)?;
+    Ok(Image {
+        width: noisy.width,
+        height: noisy.height,
+        pixels: out
+            .chunks_exact(3)
+            .map(|c| lucent_core::math::Color::new(c[0], c[1], c[2]))
+            .collect(),
+    })
+}
+
+/// The EXR channels: the colour, then the passes chosen, and the colour before denoising.
+fn channels(
+    colour: &Image,
+    noisy: Option<&Image>,
+    aovs: Option<&AovImages>,
+    sel: AovSelection,
+) -> Vec<(String, Vec<f32>)> {
+    let plane = |img: &Image, k: usize| img.pixels.iter().map(|p| p[k]).collect::<Vec<f32>>();
+    let mut out = Vec::new();
+    let mut rgb = |prefix: &str, img: &Image, names: [&str; 3]| {
+        for (k, n) in names.iter().enumerate() {
+            out.push((format!("{prefix}{n}"), plane(img, k)));
+        }
+    };
+    rgb("", colour, ["R", "G", "B"]);
+    if let Some(n) = noisy {
+        rgb("noisy.", n, ["R", "G", "B"]);
+    }
+    if let Some(a) = aovs {
+        if sel.albedo {
+            rgb("albedo.", &a.albedo, ["R", "G", "B"]);
+        }
+        if sel.normal {
+            rgb("normal.", &a.normal, ["X", "Y", "Z"]);
+        }
+        if sel.depth {
+            out.push(("depth.Z".into(), a.depth.clone()));
+        }
+        if sel.alpha {
+            out.push(("A".into(), a.alpha.clone()));
+        }
+    }
+    out
+}
