@@ -192,6 +192,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         memory_limit: args.memory_limit.unwrap_or_else(Budget::machine_default),
     };
     let lines = overrides(args.size.as_deref(), args.maxdepth.as_deref(), &args.define);
+    let parsing = Progress::phase("parsing", args.quiet);
     let mut session = if scene.as_os_str() == "-" {
         let mut text = Vec::new();
         let read = std::io::Read::read_to_end(&mut std::io::Read::take(std::io::stdin(), 1 << 30), &mut text);
@@ -203,6 +204,7 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
     } else {
         Session::parse_file_with(scene, options, &lines)
     };
+    parsing.finish();
     if args.quick {
         quick(&mut session.desc);
     }
