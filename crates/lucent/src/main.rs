@@ -1,6 +1,6 @@
 //! `lucent`: the command line. `render` makes a picture of a scene, `check` validates one
 //! and says what it holds, `diff` compares two images, `merge` puts render states
-//! together, `bench` measures speed.
+//! together, `plan` cuts a render into tasks, `bench` measures speed.
 
 mod aov_args;
 mod bench;
@@ -13,6 +13,8 @@ mod output;
 mod partial;
 mod passes;
 mod picture;
+mod plan;
+mod plan_command;
 mod progress;
 mod render;
 mod settings_args;
@@ -49,6 +51,8 @@ enum Command {
     Diff(diff::DiffArgs),
     /// Combine render state files (regions, sample ranges) into one image.
     Merge(merge::MergeArgs),
+    /// Cut a render into independent tasks (for a job array), and print how.
+    Plan(Box<plan_command::PlanArgs>),
     /// Benchmarks (figures for docs/performance.md).
     #[command(subcommand)]
     Bench(bench::BenchCommand),
@@ -61,6 +65,7 @@ fn main() -> ExitCode {
         Command::Check(a) => check::run(&a),
         Command::Diff(a) => diff::run(&a),
         Command::Merge(a) => merge::run(&a),
+        Command::Plan(a) => plan_command::run(&a),
         Command::Bench(c) => bench::run(&c),
     };
     ExitCode::from(code)

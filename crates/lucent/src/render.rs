@@ -15,6 +15,7 @@ use lucent_core::integrator::whitted::MAX_PENDING;
 use lucent_core::integrator::PixelSampling;
 use lucent_core::math::Color;
 use lucent_core::render::job::RenderJob;
+use lucent_core::render::plan::Cut;
 use lucent_core::sampler::SamplerKind;
 use lucent_io::resources::input::FileId;
 use lucent_io::resources::{Budget, OutputTarget};
@@ -27,6 +28,7 @@ use crate::output::{choose_output, report};
 use crate::partial::Partial;
 use crate::passes::{render_in_passes, Outcome};
 use crate::picture::{aov_file, write_picture, Extras};
+use crate::plan::PlanRequest;
 use crate::progress::{Finish, Progress};
 use crate::settings_args::{overrides, quick};
 use crate::signals;
@@ -81,6 +83,19 @@ pub struct RenderArgs {
     /// hash and the options) for `lucent merge` and `--resume`.
     #[arg(long, value_name = "OUT.lstate")]
     pub state: Option<PathBuf>,
+    /// Render task I (from 0) of the N that `lucent plan --tasks N` (with the same --by
+    /// and options) cuts the render into, into the state file of --state; `lucent
+    /// merge` puts the N states together.
+    #[arg(long, value_name = "I/N", value_parser = crate::plan::parse_task, conflicts_with_all = ["crop", "pixel_bounds", "samples", "resume"], requires = "state")]
+    pub task: Option<(u32, u32)>,
+    /// The plan `lucent plan --json` wrote, for --task: its task I is rendered (the
+    /// plan must be of this render: its size and spp).
+    #[arg(long, value_name = "PLAN.json", requires = "task")]
+    pub plan: Option<PathBuf>,
+    /// How --task (and `lucent plan`) cut the render: bands of rows (tiles), sample
+    /// ranges, or auto (sample ranges for the Monte Carlo integrators, else tiles).
+    #[arg(long, default_value = "auto", value_parser = clap::builder::PossibleValuesParser::new(Cut::NAMES))]
+    pub by: String,
     /// Continue the render a state file holds, up to `--spp` (or the scene's spp)
     /// samples per pixel: the same pixels, the sample indices after its last.
     #[arg(long, value_name = "STATE", conflicts_with_all = ["crop", "pixel_bounds", "samples"])]
@@ -174,7 +189,7 @@ pub fn run(args: &RenderArgs) -> u8 {
     }
     let mut worst = 0;
     for scene in &args.scenes {
-        let code = run_one(args, scene, several);
+        let code = run_one(args, scene, several, None);
         if code >= 128 {
             return code; // stopped by a signal
         }
@@ -183,7 +198,9 @@ pub fn run(args: &RenderArgs) -> u8 {
     worst
 }
 
-fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
+/// Renders one scene — or, with `planning`, prints (and writes) the plan of its render
+/// instead of rendering it.
+pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planning: Option<&PlanRequest>) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t_start = Instant::now();
     let options = SessionOptions {
@@ -356,6 +373,46 @@ fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool) -> u8 {
         aovs: job.aovs,
         noise_threshold: job.noise_threshold,
     };
+    let cut = Cut::parse(&args.by).expect("clap checked the value");
+    let task = args.task.or(planning.map(|p| (0, p.tasks)));
+    if let (Some((i, n)), Some(path), None) = (task, &args.plan, planning) {
+        let read = std::fs::read_to_string(path).map_err(|e| e.to_string());
+        match read.and_then(|text| crate::plan::task_from_json(&text, &job, i, n)) {
+            Ok((pixels, samples)) => {
+                job.pixels = pixels;
+                job.samples = samples;
+            }
+            Err(e) => {
+                eprintln!("lucent: error: --plan {}: {e}", path.display());
+                return EXIT_BAD_INPUT;
+            }
+        }
+    } else if let Some((i, n)) = task {
+        let measure = planning.is_some_and(|p| p.measure);
+        let plan = match crate::plan::make(&renderer, built, &job, n, cut, pixel_sampling == "uniform", measure) {
+            Ok(p) => p,
+            Err(e) => {
+                eprintln!("lucent: error: {e}");
+                return EXIT_BAD_INPUT;
+            }
+        };
+        if let Some(request) = planning {
+            let name = scene.display().to_string();
+            print!("{}", crate::plan::describe(&name, &job, &plan));
+            if let Some(path) = &request.json {
+                let written =
+                    OutputTarget::resolve(path).and_then(|t| t.write(crate::plan::json(&name, &job, &plan).as_bytes()));
+                if let Err(e) = written {
+                    eprintln!("lucent: error: cannot write {}: {e}", path.display());
+                    return EXIT_BAD_INPUT;
+                }
+            }
+            return 0;
+        }
+        let t = &plan.tasks[i as usize];
+        job.pixels = t.pixels;
+        job.samples = t.samples.clone();
+    }
     let (w, h) = (job.resolution.width, job.resolution.height);
     let part = pixel_rect(args.crop.as_deref(), args.pixel_bounds.as_deref(), w, h)
         .and_then(|rect| {

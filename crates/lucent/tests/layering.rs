@@ -65,12 +65,14 @@ const CLI: Floors = &[
     ("aov_args", 0),
     ("picture", 1),
     ("partial", 2),
+    ("plan", 2),
     ("passes", 1),
     ("render", 3),
     ("check", 3),
     ("diff", 3),
     ("merge", 3),
     ("bench", 3),
+    ("plan_command", 4),
 ];
 
 /// Modules of `lucent-io` that record what a file says: of `lucent-core` they may use

@@ -718,3 +718,69 @@ fn denoising_needs_the_library_and_cleans_the_noise_when_it_is_there() {
     let exr = fs::read(dir.join("d.exr")).unwrap();
     assert!(exr.windows(7).any(|w| w == b"noisy.R"));
 }
+
+#[test]
+fn the_tasks_of_a_plan_merge_into_the_one_go_bytes() {
+    let dir = workdir("plan");
+    for (integrator, by, expect) in [
+        (INTEGRATORS[2], "auto", "by samples"),
+        (INTEGRATORS[2], "tiles", "by tiles"),
+        (INTEGRATORS[0], "auto", "by tiles"),
+        (INTEGRATORS[1], "auto", "by tiles x samples"),
+    ] {
+        fs::write(dir.join("s.test"), scene(integrator)).unwrap();
+        let tasks = if expect.contains(" x ") { "24" } else { "5" };
+        let o = lucent(
+            &dir,
+            &["plan", "s.test", "--tasks", tasks, "--by", by, "--json", "plan.json"],
+        );
+        let table = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            o.status.success() && table.contains(expect),
+            "{integrator:?} {by}: {table}"
+        );
+        let json = fs::read_to_string(dir.join("plan.json")).unwrap();
+        assert_eq!(json.matches("\"index\"").count(), tasks.parse::<usize>().unwrap());
+        let n: u32 = tasks.parse().unwrap();
+        let mut states = Vec::new();
+        for i in 0..n {
+            let (task, state) = (format!("{i}/{n}"), format!("t{i}.lstate"));
+            let threads = if i % 2 == 0 { "1" } else { "2" };
+            ok(
+                &dir,
+                &[
+                    "render",
+                    "s.test",
+                    "--task",
+                    &task,
+                    "--by",
+                    by,
+                    "--state",
+                    &state,
+                    "-o",
+                    "/dev/null",
+                    "-q",
+                    "--threads",
+                    threads,
+                ],
+            );
+            states.push(state);
+        }
+        ok(&dir, &["render", "s.test", "-o", "one.png", "-q"]);
+        let mut args = vec!["merge", "-o", "m.png"];
+        args.extend(states.iter().map(String::as_str));
+        ok(&dir, &args);
+        assert!(
+            fs::read(dir.join("one.png")).unwrap() == fs::read(dir.join("m.png")).unwrap(),
+            "{integrator:?} {by}"
+        );
+    }
+    fails(
+        &dir,
+        &["render", "s.test", "--task", "5/5", "--state", "x.lstate"],
+        "tasks are numbered 0..4",
+    );
+    let o = lucent(&dir, &["render", "s.test", "--task", "1/5"]);
+    assert_eq!(o.status.code(), Some(2), "--task needs --state");
+    fails(&dir, &["plan", "s.test", "--tasks", "31"], "at least 31 rows");
+}

@@ -13,6 +13,7 @@
 
 pub mod aov;
 pub mod job;
+pub mod plan;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
