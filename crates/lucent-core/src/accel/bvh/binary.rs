@@ -9,6 +9,11 @@
 //! when no plane separates the centroids, nodes are split at the object median so the
 //! depth stays bounded. The build works on a flat array of 32-byte references that it
 //! partitions in place: no allocation per node and no indirection.
+//!
+//! Subtrees of more than [`PARALLEL_REFS`] references are built on two threads at once
+//! (`rayon::join`): each side into its own list of nodes, joined as parent, left
+//! subtree, right subtree — the very order the one-thread recursion writes — so the tree
+//! is the same, node for node, for any number of threads.
 
 use crate::aabb::Aabb;
 use crate::math::Vec3A;
@@ -23,6 +28,9 @@ pub const MAX_LEAF: usize = 4;
 /// dragons: 2 beats 0.5 and 1, and gives smaller trees; 3 and 4 are no better).
 const TRAVERSAL_COST: f32 = 2.0;
 const MEDIAN_SPLIT_DEPTH: usize = 48;
+/// Subtrees larger than this are built with their two halves in parallel; smaller ones
+/// are not worth a task.
+const PARALLEL_REFS: usize = 4096;
 
 /// A primitive's box and index, as the builder moves them around.
 #[derive(Clone, Copy, Debug)]
@@ -112,10 +120,74 @@ pub fn build(items: impl Iterator<Item = (u32, Aabb)>) -> BinaryTree {
     };
     if !tree.refs.is_empty() {
         let (b, c) = range_bounds(&tree.refs);
-        let n = tree.refs.len();
-        build_node(&mut tree, 0, n, b, c, 0);
+        tree.nodes = build_subtree(&mut tree.refs, 0, b, c, 0);
     }
     tree
+}
+
+/// The nodes of the subtree over `refs` (which start at index `offset` of the whole
+/// array), its root first; their child indices count from that root.
+fn build_subtree(refs: &mut [BuildRef], offset: usize, bounds: Aabb, cb: Aabb, depth: usize) -> Vec<BinaryNode> {
+    if refs.len() <= PARALLEL_REFS {
+        let mut tree = BinaryTree {
+            nodes: Vec::with_capacity(refs.len() / 2 + 1),
+            refs: Vec::new(),
+        };
+        build_node(&mut tree, refs, offset, 0, refs.len(), bounds, cb, depth);
+        return tree.nodes;
+    }
+    let count = refs.len();
+    let leaf = BinaryNode {
+        bounds,
+        kind: Kind::Leaf {
+            start: offset as u32,
+            count: count as u32,
+        },
+    };
+    let Some(split) = choose_split(refs, &bounds, &cb, depth) else {
+        return vec![leaf];
+    };
+    let (l, r) = refs.split_at_mut(split.mid);
+    let (left, right) = rayon::join(
+        || build_subtree(l, offset, split.left.0, split.left.1, depth + 1),
+        || build_subtree(r, offset + split.mid, split.right.0, split.right.1, depth + 1),
+    );
+    // Parent, left subtree, right subtree: the order of the one-thread recursion.
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(BinaryNode {
+        bounds,
+        kind: Kind::Interior {
+            left: 1,
+            right: 1 + left.len() as u32,
+        },
+    });
+    for part in [left, right] {
+        let base = nodes.len() as u32;
+        nodes.extend(part.into_iter().map(|mut n| {
+            if let Kind::Interior { left, right } = &mut n.kind {
+                *left += base;
+                *right += base;
+            }
+            n
+        }));
+    }
+    nodes
+}
+
+/// Where to split `refs` (partitioning them), or `None` for a leaf.
+fn choose_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb, depth: usize) -> Option<Split> {
+    let count = refs.len();
+    if count <= 1 {
+        return None;
+    }
+    if depth >= MEDIAN_SPLIT_DEPTH {
+        return Some(median_split(refs, cb));
+    }
+    match sah_split(refs, bounds, cb) {
+        Some(s) => Some(s),
+        None if count > MAX_LEAF => Some(median_split(refs, cb)),
+        None => None,
+    }
 }
 
 /// Bounds of the boxes and of the doubled centroids of `refs`.
@@ -132,32 +204,33 @@ fn range_bounds(refs: &[BuildRef]) -> (Aabb, Aabb) {
     (Aabb { min: lo, max: hi }, Aabb { min: clo, max: chi })
 }
 
-fn build_node(tree: &mut BinaryTree, start: usize, end: usize, bounds: Aabb, cb: Aabb, depth: usize) -> u32 {
+/// The one-thread recursion over `refs[start..end]` (`refs` starts at index `offset` of
+/// the whole array): pushes the node, then its left and right subtrees; returns its index.
+#[allow(clippy::too_many_arguments)]
+fn build_node(
+    tree: &mut BinaryTree,
+    refs: &mut [BuildRef],
+    offset: usize,
+    start: usize,
+    end: usize,
+    bounds: Aabb,
+    cb: Aabb,
+    depth: usize,
+) -> u32 {
     let me = tree.nodes.len();
     tree.nodes.push(BinaryNode {
         bounds,
         kind: Kind::Leaf {
-            start: start as u32,
+            start: (offset + start) as u32,
             count: (end - start) as u32,
         },
     });
-    let count = end - start;
-    if count <= 1 {
+    let Some(split) = choose_split(&mut refs[start..end], &bounds, &cb, depth) else {
         return me as u32;
-    }
-    let split = if depth >= MEDIAN_SPLIT_DEPTH {
-        Some(median_split(&mut tree.refs[start..end], &cb))
-    } else {
-        match sah_split(&mut tree.refs[start..end], &bounds, &cb) {
-            Some(s) => Some(s),
-            None if count > MAX_LEAF => Some(median_split(&mut tree.refs[start..end], &cb)),
-            None => None,
-        }
     };
-    let Some(split) = split else { return me as u32 };
     let mid = start + split.mid;
-    let left = build_node(tree, start, mid, split.left.0, split.left.1, depth + 1);
-    let right = build_node(tree, mid, end, split.right.0, split.right.1, depth + 1);
+    let left = build_node(tree, refs, offset, start, mid, split.left.0, split.left.1, depth + 1);
+    let right = build_node(tree, refs, offset, mid, end, split.right.0, split.right.1, depth + 1);
     tree.nodes[me].kind = Kind::Interior { left, right };
     me as u32
 }
@@ -291,5 +364,56 @@ fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
         v.swap(i, j - 1);
         i += 1;
         j -= 1;
+    }
+}
+
+#[cfg(test)]
+mod parallel_tests {
+    use super::*;
+
+    fn boxes(n: u32) -> Vec<(u32, Aabb)> {
+        let mut x = 0x9e37_79b9u32;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x as f32 / u32::MAX as f32
+        };
+        (0..n)
+            .map(|i| {
+                let c = Vec3A::new(next(), next(), next()) * 100.0;
+                let e = Vec3A::new(next(), next(), next());
+                (i, Aabb { min: c - e, max: c + e })
+            })
+            .collect()
+    }
+
+    /// Nodes and leaf order as plain values, to compare trees.
+    fn shape(t: &BinaryTree) -> (Vec<String>, Vec<u32>) {
+        (
+            t.nodes.iter().map(|n| format!("{n:?}")).collect(),
+            t.refs.iter().map(|r| r.prim).collect(),
+        )
+    }
+
+    #[test]
+    fn the_parallel_build_makes_the_one_thread_tree_for_any_thread_count() {
+        let items = boxes(40_000);
+        // The plain recursion, with no parallel split at all.
+        let mut refs: Vec<BuildRef> = items.iter().map(|(i, b)| BuildRef::new(b, *i)).collect();
+        let (b, c) = range_bounds(&refs);
+        let mut plain = BinaryTree {
+            nodes: Vec::new(),
+            refs: Vec::new(),
+        };
+        let n = refs.len();
+        build_node(&mut plain, &mut refs, 0, 0, n, b, c, 0);
+        plain.refs = refs;
+        let expected = shape(&plain);
+        for threads in [1, 2, 3, 8] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let tree = pool.install(|| build(items.iter().copied()));
+            assert!(shape(&tree) == expected, "{threads} threads");
+        }
     }
 }
