@@ -30,7 +30,7 @@ lucent="$(realpath "$lucent")"
 
 t="$(mktemp -d /tmp/lucent-slurm.XXXXXX)"
 chmod 755 "$t"
-host="$(hostname -s)"
+host="$(hostname -s 2>/dev/null || cut -d. -f1 /proc/sys/kernel/hostname)"
 cpus="$(nproc)"
 port=$((20000 + RANDOM % 20000))
 cleanup() {
