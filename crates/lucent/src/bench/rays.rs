@@ -37,6 +37,10 @@ pub struct RaysBenchArgs {
     /// Timed passes over the rays (the median is reported); builds are timed min(R, 3) times.
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub reps: u32,
+    /// Threads of the build (default 1: on the main thread, so that a harness that
+    /// counts the worker threads' CPU time counts the tracing alone).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub build_threads: u32,
     /// Any-hit queries (shadow rays) instead of closest hits.
     #[arg(long)]
     pub occluded: bool,
@@ -122,14 +126,19 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         .build()
         .map_err(|e| format!("cannot start worker threads: {e}"))?;
 
-    // Builds run on the pool's threads (the BVH's binary tree splits its large subtrees
-    // across them; the other structures build on one).
+    // Builds run on a pool of their own that includes this thread (the BVH splits its
+    // large subtrees across the pool's threads; the other structures build on one).
+    let build_pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.build_threads as usize)
+        .use_current_thread()
+        .build()
+        .map_err(|e| format!("cannot start build threads: {e}"))?;
     let mut build_times = Vec::new();
     let mut accel = None;
     for _ in 0..args.reps.min(3) {
         drop(accel.take());
         let t = Instant::now();
-        accel = Some(pool.install(|| kind.build(&mesh)));
+        accel = Some(build_pool.install(|| kind.build(&mesh)));
         build_times.push(t.elapsed().as_secs_f64());
     }
     let accel = accel.expect("at least one build");
@@ -171,12 +180,13 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
             .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     }
     println!(
-        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} tris={} trace_s={trace_s:.4}",
+        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
         accel.memory_bytes() as f64 / mesh.indices.len().max(1) as f64,
         rays.len(),
         kind.name(),
         pool.current_num_threads(),
+        args.build_threads,
         mesh.indices.len(),
     );
     Ok(())
