@@ -321,15 +321,66 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
         let b = ((r.lo[axis] + r.hi[axis] - lo_a) * scale_a).min((BINS - 1) as f32) as usize;
         b < split_bin
     };
-    let mid = partition(refs, goes_left);
+    let (mid, centroids) = partition_with_centroids(refs, goes_left);
     if mid == 0 || mid == count {
         return None;
     }
+    // The children's boxes are the unions of their bins' boxes (min and max are exact:
+    // the same bits as scanning the references again); their centroid bounds came from
+    // the partition.
+    let union = |bins: &[Bin]| {
+        bins.iter().fold(
+            Aabb {
+                min: Vec3A::INFINITY,
+                max: Vec3A::NEG_INFINITY,
+            },
+            |b, bin| Aabb {
+                min: b.min.min(bin.lo),
+                max: b.max.max(bin.hi),
+            },
+        )
+    };
+    let bins = &bins[axis];
     Some(Split {
         mid,
-        left: range_bounds(&refs[..mid]),
-        right: range_bounds(&refs[mid..]),
+        left: (union(&bins[..split_bin]), centroids[0]),
+        right: (union(&bins[split_bin..]), centroids[1]),
     })
+}
+
+/// In-place partition (Hoare style): how many elements satisfy `pred` (they come first),
+/// and the bounds of the doubled centroids of each side.
+fn partition_with_centroids(v: &mut [BuildRef], pred: impl Fn(&BuildRef) -> bool) -> (usize, [Aabb; 2]) {
+    let empty = Aabb {
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+    };
+    let mut sides = [empty, empty];
+    let mut add = |side: usize, r: &BuildRef| {
+        let c = r.centroid2();
+        sides[side].min = sides[side].min.min(c);
+        sides[side].max = sides[side].max.max(c);
+    };
+    let (mut i, mut j) = (0, v.len());
+    loop {
+        while i < j && pred(&v[i]) {
+            add(0, &v[i]);
+            i += 1;
+        }
+        while i < j && !pred(&v[j - 1]) {
+            add(1, &v[j - 1]);
+            j -= 1;
+        }
+        if i >= j {
+            return (i, sides);
+        }
+        // v[i] belongs right and v[j - 1] left: swapped, each is counted once.
+        add(1, &v[i]);
+        add(0, &v[j - 1]);
+        v.swap(i, j - 1);
+        i += 1;
+        j -= 1;
+    }
 }
 
 /// Splits in the middle by centroid along the widest axis (ties by index).
@@ -345,25 +396,6 @@ fn median_split(refs: &mut [BuildRef], cb: &Aabb) -> Split {
         mid,
         left: range_bounds(&refs[..mid]),
         right: range_bounds(&refs[mid..]),
-    }
-}
-
-/// In-place partition (Hoare style); returns how many elements satisfy `pred`.
-fn partition<T>(v: &mut [T], pred: impl Fn(&T) -> bool) -> usize {
-    let (mut i, mut j) = (0, v.len());
-    loop {
-        while i < j && pred(&v[i]) {
-            i += 1;
-        }
-        while i < j && !pred(&v[j - 1]) {
-            j -= 1;
-        }
-        if i >= j {
-            return i;
-        }
-        v.swap(i, j - 1);
-        i += 1;
-        j -= 1;
     }
 }
 
