@@ -222,4 +222,27 @@ mod tests {
         // Packets are mostly full.
         assert!(bvh.packets.len() * packet::LANES < prims.0.len() * 3 / 2);
     }
+
+    /// The nodes and packets as bytes, to compare whole structures.
+    fn bytes(b: &Bvh) -> Vec<u8> {
+        let raw = |p: *const u8, n: usize| unsafe { std::slice::from_raw_parts(p, n) }.to_vec();
+        let mut v = raw(b.nodes.as_ptr().cast(), std::mem::size_of_val(&b.nodes[..]));
+        v.extend(raw(b.packets.as_ptr().cast(), std::mem::size_of_val(&b.packets[..])));
+        v
+    }
+
+    #[test]
+    fn the_parallel_build_is_the_one_thread_build_byte_for_byte() {
+        // Enough triangles for several levels of parallel subtrees.
+        let prims = Triangles::random(5, 120_000);
+        let expected = bytes(&pool(1).install(|| Bvh::build(&prims)));
+        for threads in [2, 5] {
+            let bvh = pool(threads).install(|| Bvh::build(&prims));
+            assert!(bytes(&bvh) == expected, "{threads} threads");
+        }
+    }
+
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap()
+    }
 }
