@@ -39,7 +39,9 @@ pub struct BuildRef {
     pub lo: [f32; 3],
     pub prim: u32,
     pub hi: [f32; 3],
-    _pad: u32,
+    /// The reference's bin along x, y and z at the last binning (4 bits each), so that
+    /// the partition reads its side instead of computing it again.
+    bins: u32,
 }
 
 impl BuildRef {
@@ -48,7 +50,7 @@ impl BuildRef {
             lo: b.min.into(),
             prim,
             hi: b.max.into(),
-            _pad: 0,
+            bins: 0,
         }
     }
     #[inline(always)]
@@ -274,11 +276,12 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
     );
     let mut bins = [[EMPTY_BIN; BINS]; 3];
     let max_bin = Vec3A::splat((BINS - 1) as f32);
-    for r in refs.iter() {
-        let b = bin_indices(((r.centroid2() - lo) * scale).min(max_bin));
+    for r in refs.iter_mut() {
+        let b = bin_indices(((r.centroid2() - lo) * scale).min(max_bin)).map(|i| i as usize & (BINS - 1));
+        r.bins = (b[0] | b[1] << 4 | b[2] << 8) as u32;
         let (rlo, rhi) = (r.lo(), r.hi());
         for (axis, bin_axis) in bins.iter_mut().enumerate() {
-            let bin = &mut bin_axis[b[axis] as usize & (BINS - 1)];
+            let bin = &mut bin_axis[b[axis]];
             bin.lo = bin.lo.min(rlo);
             bin.hi = bin.hi.max(rhi);
             bin.count += 1;
@@ -316,11 +319,8 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
     if count <= MAX_LEAF && split_cost >= packets(count) {
         return None;
     }
-    let (lo_a, scale_a) = (lo[axis], scale[axis]);
-    let goes_left = |r: &BuildRef| {
-        let b = ((r.lo[axis] + r.hi[axis] - lo_a) * scale_a).min((BINS - 1) as f32) as usize;
-        b < split_bin
-    };
+    let shift = 4 * axis as u32;
+    let goes_left = |r: &BuildRef| ((r.bins >> shift) as usize & (BINS - 1)) < split_bin;
     let (mid, centroids) = partition_with_centroids(refs, goes_left);
     if mid == 0 || mid == count {
         return None;
