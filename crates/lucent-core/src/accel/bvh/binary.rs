@@ -31,6 +31,9 @@ const MEDIAN_SPLIT_DEPTH: usize = 48;
 /// Subtrees larger than this are built with their two halves in parallel; smaller ones
 /// are not worth a task.
 const PARALLEL_REFS: usize = 4096;
+/// Nodes over more references than this bin them on the pool's threads, in chunks whose
+/// bins are then merged (exactly: minima, maxima and counts).
+const PARALLEL_BINNING: usize = 1 << 16;
 
 /// A primitive's box and index, as the builder moves them around.
 #[derive(Clone, Copy, Debug)]
@@ -114,17 +117,41 @@ fn packets(n: usize) -> f32 {
 }
 
 /// Builds over `(primitive index, bounds)` pairs.
+#[cfg(test)]
 pub fn build(items: impl Iterator<Item = (u32, Aabb)>) -> BinaryTree {
-    let refs: Vec<BuildRef> = items.map(|(i, b)| BuildRef::new(&b, i)).collect();
+    build_refs(items.map(|(i, b)| BuildRef::new(&b, i)).collect())
+}
+
+/// Builds over the references `refs` (in this order: the tree depends on it).
+pub fn build_refs(refs: Vec<BuildRef>) -> BinaryTree {
     let mut tree = BinaryTree {
         nodes: Vec::with_capacity(refs.len() / 2 + 1),
         refs,
     };
     if !tree.refs.is_empty() {
-        let (b, c) = range_bounds(&tree.refs);
+        let (b, c) = parallel_bounds(&tree.refs);
         tree.nodes = build_subtree(&mut tree.refs, 0, b, c, 0);
     }
     tree
+}
+
+/// [`range_bounds`] over chunks on the pool's threads when there are many references
+/// (minima and maxima are exact: the same bits in any grouping).
+fn parallel_bounds(refs: &[BuildRef]) -> (Aabb, Aabb) {
+    use rayon::prelude::*;
+    if refs.len() <= PARALLEL_BINNING {
+        return range_bounds(refs);
+    }
+    refs.par_chunks(PARALLEL_BINNING / 4).map(range_bounds).reduce(
+        || {
+            let e = Aabb {
+                min: Vec3A::INFINITY,
+                max: Vec3A::NEG_INFINITY,
+            };
+            (e, e)
+        },
+        |(a, ac), (b, bc)| (a.union(&b), ac.union(&bc)),
+    )
 }
 
 /// The nodes of the subtree over `refs` (which start at index `offset` of the whole
@@ -262,18 +289,11 @@ fn area(lo: Vec3A, hi: Vec3A) -> f32 {
     e.x * e.y + e.y * e.z + e.z * e.x
 }
 
-/// Partitions at the best SAH plane, or returns `None` when a leaf is cheaper (or no
-/// plane separates the centroids).
-fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
-    let count = refs.len();
-    let extent = cb.max - cb.min;
-    let lo = cb.min;
-    // Axes with no extent get scale 0: everything lands in bin 0 and no plane is priced.
-    let scale = Vec3A::select(
-        extent.cmpgt(Vec3A::ZERO),
-        Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / extent,
-        Vec3A::ZERO,
-    );
+type Bins = [[Bin; BINS]; 3];
+
+/// Sorts the references' centroids into bins along the three axes (and notes each
+/// one's bins in it).
+fn bin_refs(refs: &mut [BuildRef], lo: Vec3A, scale: Vec3A) -> Bins {
     let mut bins = [[EMPTY_BIN; BINS]; 3];
     let max_bin = Vec3A::splat((BINS - 1) as f32);
     for r in refs.iter_mut() {
@@ -287,6 +307,41 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
             bin.count += 1;
         }
     }
+    bins
+}
+
+/// The bins of two groups of references together.
+fn merge_bins(mut a: Bins, b: Bins) -> Bins {
+    for (axis_a, axis_b) in a.iter_mut().zip(&b) {
+        for (x, y) in axis_a.iter_mut().zip(axis_b) {
+            x.lo = x.lo.min(y.lo);
+            x.hi = x.hi.max(y.hi);
+            x.count += y.count;
+        }
+    }
+    a
+}
+
+/// Partitions at the best SAH plane, or returns `None` when a leaf is cheaper (or no
+/// plane separates the centroids).
+fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
+    let count = refs.len();
+    let extent = cb.max - cb.min;
+    let lo = cb.min;
+    // Axes with no extent get scale 0: everything lands in bin 0 and no plane is priced.
+    let scale = Vec3A::select(
+        extent.cmpgt(Vec3A::ZERO),
+        Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / extent,
+        Vec3A::ZERO,
+    );
+    let bins = if count > PARALLEL_BINNING {
+        use rayon::prelude::*;
+        refs.par_chunks_mut(PARALLEL_BINNING / 4)
+            .map(|chunk| bin_refs(chunk, lo, scale))
+            .reduce(|| [[EMPTY_BIN; BINS]; 3], merge_bins)
+    } else {
+        bin_refs(refs, lo, scale)
+    };
     let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, first bin on the right)
     for axis in 0..3 {
         if scale[axis] == 0.0 {

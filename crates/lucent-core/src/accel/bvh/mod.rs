@@ -63,7 +63,18 @@ impl Bvh {
 
     /// Builds for a given instruction set (tests use this to check every path).
     pub fn build_for<P: PrimitiveSet + ?Sized>(prims: &P, isa: Isa) -> Bvh {
-        let tree = binary::build(super::bounded(prims));
+        // The references in primitive order, their boxes computed on the pool's threads.
+        let refs: Vec<binary::BuildRef> = {
+            use rayon::prelude::*;
+            (0..prims.count() as u32)
+                .into_par_iter()
+                .filter_map(|i| {
+                    let b = prims.bounds(i);
+                    super::is_bounded(&b).then(|| binary::BuildRef::new(&b, i))
+                })
+                .collect()
+        };
+        let tree = binary::build_refs(refs);
         let wide = wide::collapse(&tree, prims);
         #[cfg(target_arch = "x86_64")]
         assert!(
