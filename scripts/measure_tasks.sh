@@ -8,6 +8,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 scene="$(realpath "$1")"; n="$2"; shift 2
 lucent="${LUCENT:-$here/target/release/lucent}"
+[ -x /usr/bin/time ] || { echo "measure_tasks: needs GNU time (apt-get install time)" >&2; exit 1; }
 [ -x "$lucent" ] || (cd "$here" && cargo build --release -q)
 work="$(mktemp -d)"; trap 'rm -rf "$work"' EXIT
 cd "$work"
