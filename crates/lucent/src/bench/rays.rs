@@ -41,6 +41,10 @@ pub struct RaysBenchArgs {
     /// counts the worker threads' CPU time counts the tracing alone).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub build_threads: u32,
+    /// Trace the rays in packets of eight consecutive rays (the ray files' 8 × 8-tile
+    /// order), as the renderer does for coherent rays (`bvh` only).
+    #[arg(long)]
+    pub packets: bool,
     /// Any-hit queries (shadow rays) instead of closest hits.
     #[arg(long)]
     pub occluded: bool,
@@ -99,6 +103,30 @@ fn answer(accel: &dyn Accelerator<TriangleMesh>, prims: &TriangleMesh, ray: &Ray
     }
 }
 
+/// [`answer`] for a run of rays, in packets of eight.
+fn trace_packets(
+    bvh: &lucent_core::accel::bvh::Bvh,
+    prims: &TriangleMesh,
+    rays: &[Ray],
+    out: &mut [(f32, u32)],
+    occluded: bool,
+) {
+    let prepared: Vec<PreparedRay> = rays.iter().map(|r| PreparedRay::new(*r)).collect();
+    if occluded {
+        let mut blocked = vec![false; rays.len()];
+        bvh.occluded_rays(prims, &prepared, &mut blocked);
+        for (a, b) in out.iter_mut().zip(blocked) {
+            *a = if b { (0.0, 0) } else { (f32::INFINITY, 0) };
+        }
+    } else {
+        let mut hits = vec![None; rays.len()];
+        bvh.closest_hits(prims, &prepared, &mut hits);
+        for (a, h) in out.iter_mut().zip(hits) {
+            *a = h.map_or((f32::INFINITY, MISS), |h| (h.t, h.prim));
+        }
+    }
+}
+
 pub fn run(args: &RaysBenchArgs) -> u8 {
     match bench(args) {
         Ok(()) => 0,
@@ -145,12 +173,23 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     let build_s = super::median(build_times);
 
     let mut answers = vec![(0.0f32, 0u32); rays.len()];
+    if args.packets && kind != AccelKind::Bvh {
+        return Err("--packets traces with the bvh".into());
+    }
+    let packed = args
+        .packets
+        .then(|| build_pool.install(|| lucent_core::accel::bvh::Bvh::build(&mesh)));
     let trace = |answers: &mut [(f32, u32)]| {
         const CHUNK: usize = 4096;
         answers.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
             let rays = &rays[c * CHUNK..];
-            for (a, ray) in out.iter_mut().zip(rays) {
-                *a = answer(accel.as_ref(), &mesh, ray, args.occluded);
+            match &packed {
+                Some(bvh) => trace_packets(bvh, &mesh, &rays[..out.len()], out, args.occluded),
+                None => {
+                    for (a, ray) in out.iter_mut().zip(rays) {
+                        *a = answer(accel.as_ref(), &mesh, ray, args.occluded);
+                    }
+                }
             }
         });
     };
@@ -180,11 +219,12 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
             .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     }
     println!(
-        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
+        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={}{} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
         accel.memory_bytes() as f64 / mesh.indices.len().max(1) as f64,
         rays.len(),
         kind.name(),
+        if args.packets { "+packets" } else { "" },
         pool.current_num_threads(),
         args.build_threads,
         mesh.indices.len(),

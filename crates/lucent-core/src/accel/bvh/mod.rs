@@ -14,6 +14,7 @@
 mod binary;
 mod lanes;
 mod packet;
+pub mod ray_packet;
 mod traverse;
 mod wide;
 
@@ -85,6 +86,63 @@ impl Bvh {
             nodes: wide.nodes,
             packets: wide.packets,
             isa,
+        }
+    }
+
+    /// The closest hits of `rays` (`out[i]` for `rays[i]`): coherent rays — camera rays
+    /// of a tile, shadow rays toward one point — in packets of eight where the CPU has
+    /// AVX2 ([`ray_packet`]), the others one by one. The same answers as
+    /// [`Accelerator::closest_hit`] ray by ray.
+    pub fn closest_hits<P: PrimitiveSet + ?Sized>(&self, prims: &P, rays: &[PreparedRay], out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len());
+        self.in_packets::<ray_packet::ClosestQuery, P>(
+            prims,
+            rays,
+            |i, s| out[i] = s.1,
+            |r| (0.0, self.query::<Closest, P>(prims, r)),
+        );
+    }
+
+    /// Whether each of `rays` is blocked ([`Bvh::closest_hits`]'s packets, for any-hit
+    /// queries).
+    pub fn occluded_rays<P: PrimitiveSet + ?Sized>(&self, prims: &P, rays: &[PreparedRay], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len());
+        self.in_packets::<ray_packet::AnyQuery, P>(
+            prims,
+            rays,
+            |i, s| out[i] = s.1,
+            |r| (0.0, self.query::<Occluded, P>(prims, r)),
+        );
+    }
+
+    fn in_packets<Q: ray_packet::PacketQuery, P: PrimitiveSet + ?Sized>(
+        &self,
+        prims: &P,
+        rays: &[PreparedRay],
+        mut answer: impl FnMut(usize, Q::State),
+        single: impl Fn(&PreparedRay) -> Q::State,
+    ) {
+        for (k, chunk) in rays.chunks(ray_packet::PACKET_RAYS).enumerate() {
+            let base = k * ray_packet::PACKET_RAYS;
+            #[cfg(target_arch = "x86_64")]
+            if self.isa == Isa::Avx2 && !self.nodes.is_empty() && chunk.iter().all(ray_packet::packable) {
+                let mut states = [Q::start(&chunk[0]); ray_packet::PACKET_RAYS];
+                for (s, r) in states.iter_mut().zip(chunk) {
+                    *s = Q::start(r);
+                }
+                // SAFETY: the AVX2 path is only chosen when the CPU has AVX2 and FMA;
+                // the tree was built for these primitives.
+                unsafe {
+                    ray_packet::traverse::<Q, P>(&self.nodes, &self.packets, prims, chunk, &mut states[..chunk.len()]);
+                }
+                for (i, s) in states[..chunk.len()].iter().enumerate() {
+                    answer(base + i, *s);
+                }
+                continue;
+            }
+            for (i, r) in chunk.iter().enumerate() {
+                answer(base + i, single(r));
+            }
         }
     }
 
@@ -251,6 +309,54 @@ mod tests {
             let bvh = pool(threads).install(|| Bvh::build(&prims));
             assert!(bytes(&bvh) == expected, "{threads} threads");
         }
+    }
+
+    #[test]
+    fn packets_of_rays_give_every_ray_its_single_answer() {
+        use crate::accel::test_sets::Rng;
+        use crate::math::Vec3A;
+        use crate::ray::{PreparedRay, Ray};
+        let prims = Triangles::random(3, 20_000);
+        let bvh = Bvh::build(&prims);
+        let mut rng = Rng(77);
+        // Camera-like rays from one point through a grid (coherent, in 8-ray rows), rays
+        // from everywhere (incoherent), short shadow-like segments, and rays along an
+        // axis (traced alone).
+        let mut rays = Vec::new();
+        let eye = Vec3A::new(0.0, 0.0, -30.0);
+        for y in 0..32 {
+            for x in 0..32 {
+                let d = Vec3A::new(x as f32 / 16.0 - 1.0, y as f32 / 16.0 - 1.0, 1.0).normalize();
+                rays.push(Ray::new(eye, d));
+            }
+        }
+        for _ in 0..2000 {
+            let o = rng.vec(15.0);
+            rays.push(Ray::new(o, rng.vec(1.0).normalize()));
+        }
+        for _ in 0..1000 {
+            let o = rng.vec(12.0);
+            let d = rng.vec(1.0).normalize();
+            rays.push(Ray::segment(o, d, 1e-3, rng.range(0.5, 8.0)));
+        }
+        for k in 0..16 {
+            rays.push(Ray::new(Vec3A::new(k as f32 - 8.0, 0.5, -40.0), Vec3A::Z));
+        }
+        let prepared: Vec<PreparedRay> = rays.into_iter().map(PreparedRay::new).collect();
+        let mut hits = vec![None; prepared.len()];
+        bvh.closest_hits(&prims, &prepared, &mut hits);
+        let mut blocked = vec![false; prepared.len()];
+        bvh.occluded_rays(&prims, &prepared, &mut blocked);
+        let mut found = 0;
+        for (i, r) in prepared.iter().enumerate() {
+            assert_eq!(hits[i], bvh.closest_hit(&prims, r), "ray {i}");
+            assert_eq!(blocked[i], bvh.occluded(&prims, r), "ray {i}");
+            found += hits[i].is_some() as usize;
+        }
+        assert!(
+            found > 500 && found < prepared.len() - 500,
+            "{found} hits: a test of both"
+        );
     }
 
     fn pool(threads: usize) -> rayon::ThreadPool {

@@ -35,7 +35,7 @@ use crate::ray::PreparedRay;
 
 /// Each visit pushes at most `WIDTH - 1` entries and the tree is at most ~100 levels deep.
 const STACK_SIZE: usize = (WIDTH - 1) * 112;
-const FAR_WIDENING: f32 = 1.0 + 2.0 * gamma(3);
+pub(super) const FAR_WIDENING: f32 = 1.0 + 2.0 * gamma(3);
 const ROW_BYTES: usize = std::mem::size_of::<[f32; WIDTH]>();
 
 /// Row `offset` (bytes, see [`RayBoxes::near_row`]) of a node's bounds, from lane `lane`.
