@@ -25,7 +25,9 @@ use crate::ray::PreparedRay;
 
 /// Rays per packet.
 pub const PACKET_RAYS: usize = 8;
-const STACK_SIZE: usize = (WIDTH - 1) * 112;
+// A visit pushes every entered child (up to `WIDTH`) and pops one: 7 more per level, and
+// the tree is at most ~100 levels deep.
+const STACK_SIZE: usize = WIDTH * 112;
 
 /// Whether a ray can travel in a packet.
 pub fn packable(r: &PreparedRay) -> bool {
