@@ -51,9 +51,60 @@ pub fn parse_task(s: &str) -> Result<(u32, u32), String> {
     Ok((i, n))
 }
 
+/// What the plan part of `lucent render` / `lucent plan` decided.
+pub enum Planned {
+    /// `job` now holds the task's pixels and samples (or nothing was asked).
+    Render,
+    /// `lucent plan`: the plan was printed (and written); nothing is rendered.
+    Printed,
+}
+
+/// For `--task I/N` points `job` at task I — read from `plan_file` when given, else the
+/// plan derived here; for `lucent plan` (`planning`) prints the plan and writes its JSON.
+#[allow(clippy::too_many_arguments)]
+pub fn apply(
+    renderer: &Renderer,
+    built: &Built,
+    job: &mut RenderJob,
+    task: Option<(u32, u32)>,
+    plan_file: Option<&std::path::Path>,
+    planning: Option<&PlanRequest>,
+    cut: Cut,
+    monte_carlo: bool,
+    scene: &str,
+) -> Result<Planned, String> {
+    let task = task.or(planning.map(|p| (0, p.tasks)));
+    let Some((i, n)) = task else {
+        return Ok(Planned::Render);
+    };
+    if let (Some(path), None) = (plan_file, planning) {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("--plan {}: {e}", path.display()))?;
+        let (pixels, samples) =
+            task_from_json(&text, job, i, n).map_err(|e| format!("--plan {}: {e}", path.display()))?;
+        job.pixels = pixels;
+        job.samples = samples;
+        return Ok(Planned::Render);
+    }
+    let measure = planning.is_some_and(|p| p.measure);
+    let plan = make(renderer, built, job, n, cut, monte_carlo, measure)?;
+    if let Some(request) = planning {
+        print!("{}", describe(scene, job, &plan));
+        if let Some(path) = &request.json {
+            lucent_io::resources::OutputTarget::resolve(path)
+                .and_then(|t| t.write(json(scene, job, &plan).as_bytes()))
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        }
+        return Ok(Planned::Printed);
+    }
+    let t = &plan.tasks[i as usize];
+    job.pixels = t.pixels;
+    job.samples = t.samples.clone();
+    Ok(Planned::Render)
+}
+
 /// The plan of `job` (the whole image) in `tasks` tasks, its bands balanced by the
 /// probe's ray counts or (`measure`) its time.
-pub fn make(
+fn make(
     renderer: &Renderer,
     built: &Built,
     job: &RenderJob,
@@ -180,9 +231,17 @@ pub fn task_from_json(
     Ok((pixels, samples))
 }
 
+/// Each task's share of the plan's whole cost.
+fn shares(plan: &Plan) -> Vec<f64> {
+    let total: f64 = plan.tasks.iter().map(|t| t.cost).sum();
+    plan.tasks
+        .iter()
+        .map(|t| t.cost / total.max(f64::MIN_POSITIVE))
+        .collect()
+}
+
 /// The plan as a table for people.
 pub fn describe(scene: &str, job: &RenderJob, plan: &Plan) -> String {
-    let total: f64 = plan.tasks.iter().map(|t| t.cost).sum();
     let mut out = format!(
         "{scene}: {} x {}, samples {}..{} per pixel, {} tasks by {} (the costliest task is {:.2} x the mean)\n",
         job.resolution.width,
@@ -194,7 +253,7 @@ pub fn describe(scene: &str, job: &RenderJob, plan: &Plan) -> String {
         plan.imbalance()
     );
     out.push_str("task  pixels x0..x1, y0..y1   samples     share of the cost\n");
-    for (i, t) in plan.tasks.iter().enumerate() {
+    for (i, (t, share)) in plan.tasks.iter().zip(shares(plan)).enumerate() {
         let p = t.pixels;
         let _ = writeln!(
             out,
@@ -205,7 +264,7 @@ pub fn describe(scene: &str, job: &RenderJob, plan: &Plan) -> String {
             p.y1,
             t.samples.start,
             t.samples.end - 1,
-            t.cost / total.max(f64::MIN_POSITIVE)
+            share
         );
     }
     out
@@ -214,7 +273,6 @@ pub fn describe(scene: &str, job: &RenderJob, plan: &Plan) -> String {
 /// The plan as JSON (pixels `[x0, x1, y0, y1]` with exclusive ends, samples
 /// `[first, last]` inclusive as `--samples` takes them, cost as a share of the whole).
 pub fn json(scene: &str, job: &RenderJob, plan: &Plan) -> String {
-    let total: f64 = plan.tasks.iter().map(|t| t.cost).sum();
     let escaped: String = scene
         .chars()
         .flat_map(|c| match c {
@@ -231,7 +289,7 @@ pub fn json(scene: &str, job: &RenderJob, plan: &Plan) -> String {
         plan.by,
         plan.imbalance()
     );
-    for (i, t) in plan.tasks.iter().enumerate() {
+    for (i, (t, share)) in plan.tasks.iter().zip(shares(plan)).enumerate() {
         let p = t.pixels;
         let _ = write!(
             out,
@@ -242,7 +300,7 @@ pub fn json(scene: &str, job: &RenderJob, plan: &Plan) -> String {
             p.y1,
             t.samples.start,
             t.samples.end - 1,
-            t.cost / total.max(f64::MIN_POSITIVE),
+            share,
             if i + 1 < plan.tasks.len() { "," } else { "" }
         );
     }

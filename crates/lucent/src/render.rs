@@ -28,7 +28,7 @@ use crate::output::{choose_output, report};
 use crate::partial::Partial;
 use crate::passes::{render_in_passes, Outcome};
 use crate::picture::{aov_file, write_picture, Extras};
-use crate::plan::PlanRequest;
+use crate::plan::{PlanRequest, Planned};
 use crate::progress::{Finish, Progress};
 use crate::settings_args::{overrides, quick};
 use crate::signals;
@@ -374,44 +374,24 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         noise_threshold: job.noise_threshold,
     };
     let cut = Cut::parse(&args.by).expect("clap checked the value");
-    let task = args.task.or(planning.map(|p| (0, p.tasks)));
-    if let (Some((i, n)), Some(path), None) = (task, &args.plan, planning) {
-        let read = std::fs::read_to_string(path).map_err(|e| e.to_string());
-        match read.and_then(|text| crate::plan::task_from_json(&text, &job, i, n)) {
-            Ok((pixels, samples)) => {
-                job.pixels = pixels;
-                job.samples = samples;
-            }
-            Err(e) => {
-                eprintln!("lucent: error: --plan {}: {e}", path.display());
-                return EXIT_BAD_INPUT;
-            }
+    let planned = crate::plan::apply(
+        &renderer,
+        built,
+        &mut job,
+        args.task,
+        args.plan.as_deref(),
+        planning,
+        cut,
+        pixel_sampling == "uniform",
+        &scene.display().to_string(),
+    );
+    match planned {
+        Ok(Planned::Render) => {}
+        Ok(Planned::Printed) => return 0,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
         }
-    } else if let Some((i, n)) = task {
-        let measure = planning.is_some_and(|p| p.measure);
-        let plan = match crate::plan::make(&renderer, built, &job, n, cut, pixel_sampling == "uniform", measure) {
-            Ok(p) => p,
-            Err(e) => {
-                eprintln!("lucent: error: {e}");
-                return EXIT_BAD_INPUT;
-            }
-        };
-        if let Some(request) = planning {
-            let name = scene.display().to_string();
-            print!("{}", crate::plan::describe(&name, &job, &plan));
-            if let Some(path) = &request.json {
-                let written =
-                    OutputTarget::resolve(path).and_then(|t| t.write(crate::plan::json(&name, &job, &plan).as_bytes()));
-                if let Err(e) = written {
-                    eprintln!("lucent: error: cannot write {}: {e}", path.display());
-                    return EXIT_BAD_INPUT;
-                }
-            }
-            return 0;
-        }
-        let t = &plan.tasks[i as usize];
-        job.pixels = t.pixels;
-        job.samples = t.samples.clone();
     }
     let (w, h) = (job.resolution.width, job.resolution.height);
     let part = pixel_rect(args.crop.as_deref(), args.pixel_bounds.as_deref(), w, h)

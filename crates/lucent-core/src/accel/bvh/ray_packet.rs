@@ -17,8 +17,8 @@
 //! traced alone.
 
 use super::packet::Packet;
-use super::traverse::FAR_WIDENING;
-use super::wide::{WideNode, EMPTY, FIRST_MASK, LEAF, PACKET_SHIFT, WIDTH};
+use super::traverse::{leaf_packets, FAR_WIDENING};
+use super::wide::{WideNode, EMPTY, LEAF, WIDTH};
 use crate::accel::{search_limit, PrimitiveSet};
 use crate::hit::Hit;
 use crate::ray::PreparedRay;
@@ -89,13 +89,6 @@ unsafe fn enters(
     }
     let ok = _mm256_cmp_ps::<_CMP_LE_OQ>(near, far);
     (_mm256_movemask_ps(ok) as u32, near)
-}
-
-#[inline(always)]
-fn leaf_packets(reference: u32) -> std::ops::Range<usize> {
-    let first = (reference & FIRST_MASK) as usize;
-    let n = ((reference & !LEAF) >> PACKET_SHIFT) as usize + 1;
-    first..first + n
 }
 
 /// What a packet query does at a leaf for one ray: closest hit or any hit.

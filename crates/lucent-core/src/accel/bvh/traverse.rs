@@ -299,8 +299,9 @@ unsafe fn node_at(nodes: &[WideNode], offset: u32) -> &WideNode {
     &*nodes.as_ptr().cast::<u8>().add(offset as usize).cast::<WideNode>()
 }
 
+/// The packets of leaf reference `reference`.
 #[inline(always)]
-fn leaf_packets(reference: u32) -> std::ops::Range<usize> {
+pub(super) fn leaf_packets(reference: u32) -> std::ops::Range<usize> {
     let first = (reference & FIRST_MASK) as usize;
     let n = ((reference & !LEAF) >> PACKET_SHIFT) as usize + 1;
     first..first + n
