@@ -75,6 +75,7 @@ impl PreparedRay {
         r
     }
 
+    #[inline]
     pub fn new(ray: Ray) -> PreparedRay {
         let d = ray.dir;
         // One vector division; the rare zero or subnormal components are fixed after.

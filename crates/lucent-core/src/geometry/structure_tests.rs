@@ -19,21 +19,14 @@ fn structures(prims: &[Primitive]) -> Vec<Named> {
         .filter(|&&k| k != AccelKind::List)
         .map(|&k| (k.name().to_string(), k.build(prims)))
         .collect();
-    let mut isas = vec![Isa::Scalar];
-    #[cfg(target_arch = "x86_64")]
-    {
-        isas.push(Isa::Sse2);
-        if Isa::detect() == Isa::Avx2 {
-            isas.push(Isa::Avx2);
-        }
-    }
-    for isa in isas {
+    for isa in Isa::available() {
         all.push((format!("bvh/{isa:?}"), Box::new(Bvh::build_for(prims, isa))));
     }
     all
 }
 
-/// Checks every structure against the list; returns how many rays hit something.
+/// Checks every structure against the list, and the BVH's packets of rays on every
+/// instruction set; returns how many rays hit something.
 fn check_against_list(prims: &[Primitive], rays: &[Ray]) -> usize {
     let list = PrimitiveList::new(prims);
     let expected: Vec<_> = rays
@@ -54,6 +47,21 @@ fn check_against_list(prims: &[Primitive], rays: &[Ray]) -> usize {
                 accel.occluded(prims, &PreparedRay::new(*ray)),
                 *occluded,
                 "{name}: occlusion differs for {ray:?}"
+            );
+        }
+    }
+    for isa in Isa::available() {
+        let bvh = Bvh::build_for(prims, isa);
+        let mut hits = vec![None; rays.len()];
+        bvh.closest_hits(prims, rays, &mut hits);
+        let mut blocked = vec![false; rays.len()];
+        bvh.occluded_rays(prims, rays, &mut blocked);
+        for (i, (hit, occluded)) in expected.iter().enumerate() {
+            assert_eq!(hits[i], *hit, "packets/{isa:?}: closest hit differs for {:?}", rays[i]);
+            assert_eq!(
+                blocked[i], *occluded,
+                "packets/{isa:?}: occlusion differs for {:?}",
+                rays[i]
             );
         }
     }
@@ -81,6 +89,38 @@ fn random_soups_match_the_list() {
         let prims = soup(seed, 700);
         let rays = random_rays(&mut Rng(seed * 31), 3000, 15.0, 8.0);
         assert!(check_against_list(&prims, &rays) > 500);
+    }
+}
+
+/// Rays from a few eyes through grids of directions, row by row: consecutive rays are
+/// coherent, as camera rays of a tile are, so packets share their axes and test leaves
+/// across rays.
+fn fans(rng: &mut Rng, eyes: usize, spread: f32, t_max: f32) -> Vec<Ray> {
+    let mut rays = Vec::new();
+    for _ in 0..eyes {
+        let eye = rng.vec(spread);
+        let ahead = (rng.vec(2.0) - eye).normalize();
+        let side = ahead.cross(Vec3A::Y).normalize_or(Vec3A::X);
+        let up = side.cross(ahead);
+        for y in 0..32 {
+            for x in 0..32 {
+                let (u, v) = (x as f32 / 16.0 - 1.0, y as f32 / 16.0 - 1.0);
+                rays.push(Ray::segment(eye, (ahead + side * u + up * v).normalize(), 1e-4, t_max));
+            }
+        }
+    }
+    rays
+}
+
+#[test]
+fn coherent_fans_of_rays_match_the_list() {
+    for seed in 1..4 {
+        let prims = soup(seed, 3000);
+        let mut rng = Rng(seed * 7);
+        let mut rays = fans(&mut rng, 3, 20.0, f32::INFINITY);
+        rays.extend(fans(&mut rng, 2, 20.0, 18.0));
+        let hits = check_against_list(&prims, &rays);
+        assert!(hits > 1000 && hits < rays.len() - 500, "{hits} of {}", rays.len());
     }
 }
 

@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use lucent_core::accel::bvh::{Bvh, Isa};
 use lucent_core::accel::{AccelKind, Accelerator};
 use lucent_core::geometry::mesh::TriangleMesh;
 use lucent_core::math::Vec3A;
@@ -41,8 +42,12 @@ pub struct RaysBenchArgs {
     /// counts the worker threads' CPU time counts the tracing alone).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub build_threads: u32,
-    /// Trace the rays in packets of eight consecutive rays (the ray files' 8 × 8-tile
-    /// order), as the renderer does for coherent rays (`bvh` only).
+    /// The BVH's instruction set (default: the best this CPU has), to compare them on
+    /// one machine: avx512, avx2, sse2 or scalar.
+    #[arg(long, value_parser = ["avx512", "avx2", "sse2", "scalar"])]
+    pub isa: Option<String>,
+    /// Trace the rays in packets of consecutive rays (16 with AVX-512, 8 with AVX2: the
+    /// ray files' 8 × 8-tile order), as the renderer does for coherent rays (`bvh` only).
     #[arg(long)]
     pub packets: bool,
     /// Any-hit queries (shadow rays) instead of closest hits.
@@ -103,26 +108,24 @@ fn answer(accel: &dyn Accelerator<TriangleMesh>, prims: &TriangleMesh, ray: &Ray
     }
 }
 
-/// [`answer`] for a run of rays, in packets of eight.
-fn trace_packets(
-    bvh: &lucent_core::accel::bvh::Bvh,
-    prims: &TriangleMesh,
-    rays: &[Ray],
-    out: &mut [(f32, u32)],
-    occluded: bool,
-) {
-    let prepared: Vec<PreparedRay> = rays.iter().map(|r| PreparedRay::new(*r)).collect();
-    if occluded {
-        let mut blocked = vec![false; rays.len()];
-        bvh.occluded_rays(prims, &prepared, &mut blocked);
-        for (a, b) in out.iter_mut().zip(blocked) {
-            *a = if b { (0.0, 0) } else { (f32::INFINITY, 0) };
-        }
-    } else {
-        let mut hits = vec![None; rays.len()];
-        bvh.closest_hits(prims, &prepared, &mut hits);
-        for (a, h) in out.iter_mut().zip(hits) {
-            *a = h.map_or((f32::INFINITY, MISS), |h| (h.t, h.prim));
+/// [`answer`] for a run of rays, in packets ([`Bvh::closest_hits`]), one 8 × 8 tile of
+/// the ray files at a time, as the renderer traces a tile's rays.
+fn trace_packets(bvh: &Bvh, prims: &TriangleMesh, rays: &[Ray], out: &mut [(f32, u32)], occluded: bool) {
+    const TILE: usize = 64;
+    let mut hits = [None; TILE];
+    let mut blocked = [false; TILE];
+    for (rays, out) in rays.chunks(TILE).zip(out.chunks_mut(TILE)) {
+        let n = rays.len();
+        if occluded {
+            bvh.occluded_rays(prims, rays, &mut blocked[..n]);
+            for (a, &b) in out.iter_mut().zip(&blocked) {
+                *a = if b { (0.0, 0) } else { (f32::INFINITY, 0) };
+            }
+        } else {
+            bvh.closest_hits(prims, rays, &mut hits[..n]);
+            for (a, h) in out.iter_mut().zip(&hits) {
+                *a = h.map_or((f32::INFINITY, MISS), |h| (h.t, h.prim));
+            }
         }
     }
 }
@@ -161,12 +164,36 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         .use_current_thread()
         .build()
         .map_err(|e| format!("cannot start build threads: {e}"))?;
+    let isa = match args.isa.as_deref() {
+        None => Isa::detect(),
+        Some(name) => {
+            let isa = match name {
+                "avx512" => Isa::Avx512,
+                "avx2" => Isa::Avx2,
+                "sse2" => Isa::Sse2,
+                _ => Isa::Scalar,
+            };
+            if kind != AccelKind::Bvh {
+                return Err("--isa chooses the bvh's instruction set".into());
+            }
+            if !Isa::available().contains(&isa) {
+                return Err(format!("--isa {name}: this CPU does not have it"));
+            }
+            isa
+        }
+    };
+    let build = || -> Box<dyn Accelerator<TriangleMesh>> {
+        match kind {
+            AccelKind::Bvh => Box::new(Bvh::build_for(&mesh, isa)),
+            _ => kind.build(&mesh),
+        }
+    };
     let mut build_times = Vec::new();
     let mut accel = None;
     for _ in 0..args.reps.min(3) {
         drop(accel.take());
         let t = Instant::now();
-        accel = Some(build_pool.install(|| kind.build(&mesh)));
+        accel = Some(build_pool.install(build));
         build_times.push(t.elapsed().as_secs_f64());
     }
     let accel = accel.expect("at least one build");
@@ -176,9 +203,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     if args.packets && kind != AccelKind::Bvh {
         return Err("--packets traces with the bvh".into());
     }
-    let packed = args
-        .packets
-        .then(|| build_pool.install(|| lucent_core::accel::bvh::Bvh::build(&mesh)));
+    let packed = args.packets.then(|| build_pool.install(|| Bvh::build_for(&mesh, isa)));
     let trace = |answers: &mut [(f32, u32)]| {
         const CHUNK: usize = 4096;
         answers.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
@@ -219,7 +244,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
             .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     }
     println!(
-        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={}{} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
+        "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={}{} isa={isa:?} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
         accel.memory_bytes() as f64 / mesh.indices.len().max(1) as f64,
         rays.len(),

@@ -10,43 +10,76 @@
 //! halves when not; nearest child first, an explicit fixed-size stack, no allocation per
 //! ray; the packet test is bit-identical to the scalar watertight triangle test, so the answers
 //! are exactly the brute-force list's.
+//!
+//! Coherent rays can also travel in packets ([`ray_packet`]): eight rays with AVX2,
+//! sixteen with AVX-512 ([`Bvh::closest_hits`], [`Bvh::occluded_rays`]).
 
 mod binary;
 mod lanes;
 mod packet;
+mod ray_lanes;
 pub mod ray_packet;
+mod ray_triangle;
 mod traverse;
 mod wide;
 
 use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
-use crate::ray::PreparedRay;
+use crate::ray::{PreparedRay, Ray};
 use packet::Packet;
 use traverse::{BoxTest, FmaOffsets, RayBoxes, Slab};
 use wide::WideNode;
 
-/// The box-test implementation chosen for this CPU.
+/// The instruction set the traversal uses on this CPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
-    /// AVX2 with FMA (every AVX2 CPU has both).
+    /// AVX-512 F, VL and BW (with AVX2 and FMA): single rays as with AVX2, packets of
+    /// sixteen rays.
+    Avx512,
+    /// AVX2 with FMA (every AVX2 CPU has both): packets of eight rays.
     Avx2,
     Sse2,
     Scalar,
 }
 
 impl Isa {
+    /// The best this CPU can run.
     pub fn detect() -> Isa {
+        Isa::available()[0]
+    }
+
+    /// Every instruction set this CPU can run, best first.
+    pub fn available() -> Vec<Isa> {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma") {
-                Isa::Avx2
-            } else {
-                Isa::Sse2
+            use std::arch::is_x86_feature_detected as has;
+            let mut v = Vec::new();
+            let avx2 = has!("avx2") && has!("fma");
+            if avx2 && has!("avx512f") && has!("avx512vl") && has!("avx512bw") {
+                v.push(Isa::Avx512);
             }
+            if avx2 {
+                v.push(Isa::Avx2);
+            }
+            v.extend([Isa::Sse2, Isa::Scalar]);
+            v
         }
         #[cfg(not(target_arch = "x86_64"))]
         {
-            Isa::Scalar
+            vec![Isa::Scalar]
+        }
+    }
+
+    /// Whether this CPU has AVX2 and FMA (the fused box test and packets).
+    pub fn has_avx2(self) -> bool {
+        matches!(self, Isa::Avx512 | Isa::Avx2)
+    }
+
+    /// How many rays a packet holds.
+    pub fn packet_rays(self) -> usize {
+        match self {
+            Isa::Avx512 => 16,
+            _ => 8,
         }
     }
 }
@@ -77,11 +110,7 @@ impl Bvh {
         };
         let tree = binary::build_refs(refs);
         let wide = wide::collapse(&tree, prims);
-        #[cfg(target_arch = "x86_64")]
-        assert!(
-            isa != Isa::Avx2 || Isa::detect() == Isa::Avx2,
-            "AVX2 and FMA requested on a CPU without them"
-        );
+        assert!(Isa::available().contains(&isa), "{isa:?} requested on a CPU without it");
         Bvh {
             nodes: wide.nodes,
             packets: wide.packets,
@@ -90,53 +119,59 @@ impl Bvh {
     }
 
     /// The closest hits of `rays` (`out[i]` for `rays[i]`): coherent rays — camera rays
-    /// of a tile, shadow rays toward one point — in packets of eight where the CPU has
-    /// AVX2 ([`ray_packet`]), the others one by one. The same answers as
+    /// of a tile, shadow rays toward one point — in packets of [`Bvh::packet_rays`] where
+    /// the CPU has AVX2 ([`ray_packet`]), the others one by one. The same answers as
     /// [`Accelerator::closest_hit`] ray by ray.
-    pub fn closest_hits<P: PrimitiveSet + ?Sized>(&self, prims: &P, rays: &[PreparedRay], out: &mut [Option<Hit>]) {
+    pub fn closest_hits<P: PrimitiveSet + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len());
         self.in_packets::<ray_packet::ClosestQuery, P>(
             prims,
             rays,
             |i, s| out[i] = s.1,
-            |r| (0.0, self.query::<Closest, P>(prims, r)),
+            |r| (0.0, self.query::<Closest, P>(prims, &PreparedRay::new(*r))),
         );
     }
 
     /// Whether each of `rays` is blocked ([`Bvh::closest_hits`]'s packets, for any-hit
     /// queries).
-    pub fn occluded_rays<P: PrimitiveSet + ?Sized>(&self, prims: &P, rays: &[PreparedRay], out: &mut [bool]) {
+    pub fn occluded_rays<P: PrimitiveSet + ?Sized>(&self, prims: &P, rays: &[Ray], out: &mut [bool]) {
         assert_eq!(rays.len(), out.len());
         self.in_packets::<ray_packet::AnyQuery, P>(
             prims,
             rays,
             |i, s| out[i] = s.1,
-            |r| (0.0, self.query::<Occluded, P>(prims, r)),
+            |r| (0.0, self.query::<Occluded, P>(prims, &PreparedRay::new(*r))),
         );
     }
 
     fn in_packets<Q: ray_packet::PacketQuery, P: PrimitiveSet + ?Sized>(
         &self,
         prims: &P,
-        rays: &[PreparedRay],
+        rays: &[Ray],
         mut answer: impl FnMut(usize, Q::State),
-        single: impl Fn(&PreparedRay) -> Q::State,
+        single: impl Fn(&Ray) -> Q::State,
     ) {
-        for (k, chunk) in rays.chunks(ray_packet::PACKET_RAYS).enumerate() {
-            let base = k * ray_packet::PACKET_RAYS;
+        let width = self.packet_rays();
+        for (k, chunk) in rays.chunks(width).enumerate() {
+            let base = k * width;
             #[cfg(target_arch = "x86_64")]
-            if self.isa == Isa::Avx2 && !self.nodes.is_empty() && chunk.iter().all(ray_packet::packable) {
-                let mut states = [Q::start(&chunk[0]); ray_packet::PACKET_RAYS];
+            if self.isa.has_avx2() && !self.nodes.is_empty() {
+                let mut states = [Q::start(&chunk[0]); ray_packet::MAX_PACKET];
                 for (s, r) in states.iter_mut().zip(chunk) {
                     *s = Q::start(r);
                 }
-                // SAFETY: the AVX2 path is only chosen when the CPU has AVX2 and FMA;
-                // the tree was built for these primitives.
-                unsafe {
-                    ray_packet::traverse::<Q, P>(&self.nodes, &self.packets, prims, chunk, &mut states[..chunk.len()]);
-                }
-                for (i, s) in states[..chunk.len()].iter().enumerate() {
-                    answer(base + i, *s);
+                let (nodes, packets, states) = (&self.nodes, &self.packets, &mut states[..chunk.len()]);
+                // SAFETY: `isa` was checked against the CPU when the tree was built for
+                // these primitives.
+                let alone = unsafe {
+                    if self.isa == Isa::Avx512 {
+                        ray_packet::traverse_avx512::<Q, P>(nodes, packets, prims, chunk, states)
+                    } else {
+                        ray_packet::traverse_avx2::<Q, P>(nodes, packets, prims, chunk, states)
+                    }
+                };
+                for (i, s) in states.iter().enumerate() {
+                    answer(base + i, if alone & 1 << i != 0 { single(&chunk[i]) } else { *s });
                 }
                 continue;
             }
@@ -144,6 +179,11 @@ impl Bvh {
                 answer(base + i, single(r));
             }
         }
+    }
+
+    /// How many rays [`Bvh::closest_hits`] traces together: 16 with AVX-512, else 8.
+    pub fn packet_rays(&self) -> usize {
+        self.isa.packet_rays()
     }
 
     pub fn node_count(&self) -> usize {
@@ -237,11 +277,11 @@ impl Bvh {
         let zero = r.zero_axes.any();
         // SAFETY: node and packet references were built by `wide::collapse` for these
         // primitives; the AVX2 path is only taken when the CPU has AVX2 and FMA
-        // (checked at build); SSE2 is part of x86-64.
+        // (`isa` checked at build); SSE2 is part of x86-64.
         unsafe {
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
+                Isa::Avx512 | Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
                 #[cfg(target_arch = "x86_64")]
                 Isa::Sse2 if zero => {
                     Q::run::<Slab<lanes::Sse>, true>(self, prims, r, &Slab::prepare(&RayBoxes::new(r)))
@@ -315,7 +355,6 @@ mod tests {
     fn packets_of_rays_give_every_ray_its_single_answer() {
         use crate::accel::test_sets::Rng;
         use crate::math::Vec3A;
-        use crate::ray::{PreparedRay, Ray};
         let prims = Triangles::random(3, 20_000);
         let bvh = Bvh::build(&prims);
         let mut rng = Rng(77);
@@ -342,11 +381,11 @@ mod tests {
         for k in 0..16 {
             rays.push(Ray::new(Vec3A::new(k as f32 - 8.0, 0.5, -40.0), Vec3A::Z));
         }
-        let prepared: Vec<PreparedRay> = rays.into_iter().map(PreparedRay::new).collect();
+        let prepared: Vec<PreparedRay> = rays.iter().copied().map(PreparedRay::new).collect();
         let mut hits = vec![None; prepared.len()];
-        bvh.closest_hits(&prims, &prepared, &mut hits);
+        bvh.closest_hits(&prims, &rays, &mut hits);
         let mut blocked = vec![false; prepared.len()];
-        bvh.occluded_rays(&prims, &prepared, &mut blocked);
+        bvh.occluded_rays(&prims, &rays, &mut blocked);
         let mut found = 0;
         for (i, r) in prepared.iter().enumerate() {
             assert_eq!(hits[i], bvh.closest_hit(&prims, r), "ray {i}");

@@ -54,6 +54,22 @@ impl Packet {
         pk
     }
 
+    /// What lane `lane` holds. Used lanes come first: after the first unused one, all are.
+    #[inline(always)]
+    pub fn lane_kind(&self, lane: usize) -> LaneKind {
+        match self.ids[lane] {
+            UNUSED => LaneKind::Unused,
+            id if id & OTHER != 0 => LaneKind::Other(id & !OTHER),
+            id => LaneKind::Triangle(id),
+        }
+    }
+
+    /// Coordinate `axis` of corner `c` of the triangle in `lane`.
+    #[inline(always)]
+    pub fn corner(&self, c: usize, axis: usize, lane: usize) -> f32 {
+        self.p[c][axis][lane]
+    }
+
     /// Scene index of the primitive in `lane`, if the lane is used.
     #[cfg(test)]
     pub fn prim(&self, lane: usize) -> Option<u32> {
@@ -117,8 +133,9 @@ impl Packet {
         }
     }
 
+    /// The scalar test (with its f64 fallback) of the triangle in `lane`.
     #[cold]
-    fn scalar_triangle(&self, r: &PreparedRay, lane: usize, t_max: f32) -> Option<(f32, f32, f32)> {
+    pub(super) fn scalar_triangle(&self, r: &PreparedRay, lane: usize, t_max: f32) -> Option<(f32, f32, f32)> {
         let corner = |c: usize| crate::math::Vec3A::new(self.p[c][0][lane], self.p[c][1][lane], self.p[c][2][lane]);
         triangle::intersect(r, corner(0), corner(1), corner(2), t_max).map(|h| (h.t, h.b1, h.b2))
     }
@@ -215,6 +232,15 @@ impl Packet {
         let _ = (r, t_max);
         LaneHits::none(scalar)
     }
+}
+
+/// The primitive a packet lane holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LaneKind {
+    Triangle(u32),
+    /// A primitive that is not a triangle: tested by the primitive's own code.
+    Other(u32),
+    Unused,
 }
 
 struct LaneHits {

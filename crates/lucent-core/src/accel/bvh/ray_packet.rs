@@ -1,101 +1,174 @@
-//! Packets of up to eight coherent rays (camera rays of a tile, shadow rays toward one
-//! light) walked through the wide BVH together: one AVX lane per ray. At a node, each
-//! child box is tested against every active ray of the packet; a child that some ray
-//! enters is pushed with the mask of those rays; at a leaf, each of them runs the
-//! single-ray packet test. The work per ray is that of a single ray, but eight rays'
-//! independent tests fill the pipeline that one ray's chain of dependent loads leaves
-//! idle, and a node is fetched once for all of them.
+//! Packets of coherent rays (camera rays of a tile, shadow rays toward one light) walked
+//! through the wide BVH together, one SIMD lane per ray: eight with AVX2, sixteen with
+//! AVX-512 ([`super::ray_lanes`]). At a node, each child box is tested against every
+//! active ray of the packet; a child that some ray enters is pushed with the mask of
+//! those rays. At a leaf reached by several rays that share their dominant axis, each
+//! triangle is tested against all of them at once ([`super::ray_triangle`]); otherwise
+//! each ray runs the single-ray four-triangle test. A node is fetched once for the whole
+//! packet, and the lanes' independent work fills the pipeline that one ray's chain of
+//! dependent loads leaves idle.
 //!
-//! **The same answers.** Each ray's box test is the plain slab test of
-//! [`super::traverse`] (`(plane − origin) · (1/d)`, the far reciprocal widened by
-//! `1 + 2γ(3)`), written with `min`/`max` of the two planes instead of choosing them by
-//! the direction's sign — the same two products, so the same entry and exit distances,
-//! and a ray enters exactly the boxes it enters alone (against its own closest hit so far
-//! and search limit). Leaves use the single-ray triangle tests, which accept `t ≤ t_max`
-//! and keep ties by primitive index, so the order of visits cannot change a ray's
-//! answer. Rays that do not move along an axis, or whose reciprocals are not finite, are
+//! **The same answers.** Each ray's box test is the fused test of [`super::traverse`]
+//! (`plane · (1/d) − o/d` with the offsets of [`FmaOffsets`]), which never rejects a box
+//! the exact slab test enters: the planes are chosen by the direction's signs when the
+//! whole packet shares them, else both are computed and the `min`/`max` taken (the
+//! bound holds for both). So every ray visits at least the boxes that hold its closest
+//! hit, against its own closest hit so far and search limit. Both leaf tests compute the scalar triangle test's bits, accept
+//! `t ≤ t_max` and keep ties by primitive index, so neither the order of visits nor the
+//! order of triangles within a leaf can change a ray's answer. Rays without the fused
+//! test's constants (an axis they do not move along, a constant that is not finite) are
 //! traced alone.
 
-use super::packet::Packet;
-use super::traverse::{leaf_packets, FAR_WIDENING};
+use super::packet::{LaneKind, Packet};
+use super::ray_lanes::RayLanes;
+use super::ray_triangle::{self, ShearedRays};
+use super::traverse::{leaf_packets, FmaOffsets};
 use super::wide::{WideNode, EMPTY, LEAF, WIDTH};
 use crate::accel::{search_limit, PrimitiveSet};
 use crate::hit::Hit;
-use crate::ray::PreparedRay;
+use crate::ray::{PreparedRay, Ray};
+use std::mem::MaybeUninit;
 
-/// Rays per packet.
-pub const PACKET_RAYS: usize = 8;
+/// The most rays a packet holds (AVX-512's sixteen lanes).
+pub const MAX_PACKET: usize = 16;
 // A visit pushes every entered child (up to `WIDTH`) and pops one: 7 more per level, and
 // the tree is at most ~100 levels deep.
 const STACK_SIZE: usize = WIDTH * 112;
+/// A leaf reached by at least this many rays of a packet that shares its axes is tested
+/// triangle by triangle across the rays; by fewer, ray by ray (four triangles at a time).
+const LANE_LEAF_RAYS: u32 = 3;
 
-/// Whether a ray can travel in a packet.
-pub fn packable(r: &PreparedRay) -> bool {
-    !r.zero_axes.any()
-        && r.inv_dir.is_finite()
-        && r.ray.origin.is_finite()
-        && r.ray.t_min >= 0.0
-        && (r.inv_dir * FAR_WIDENING).is_finite()
+/// The rays' box-test constants, one lane each: the fused test of [`FmaOffsets`] (whose
+/// bound holds lane by lane), a plane `b` giving the near distance `b · inv − near_off`
+/// and the far distance `b · inv_far − far_off`.
+struct BoxLanes<L> {
+    inv: [L; 3],
+    near_off: [L; 3],
+    inv_far: [L; 3],
+    far_off: [L; 3],
+    t_min: L,
+    /// Per axis, the rows of a node's bounds holding the planes every ray of the packet
+    /// enters and leaves by, when they all move the same way along every axis.
+    rows: Option<[(usize, usize); 3]>,
 }
 
-/// The rays' constants, one lane each (unused lanes copy lane 0 and are never active).
-#[cfg(target_arch = "x86_64")]
-struct Lanes8 {
-    origin: [std::arch::x86_64::__m256; 3],
-    inv: [std::arch::x86_64::__m256; 3],
-    inv_far: [std::arch::x86_64::__m256; 3],
-    t_min: std::arch::x86_64::__m256,
+/// A packet's rays as lanes: what the box test and the triangle test need.
+struct PacketLanes<L> {
+    boxes: BoxLanes<L>,
+    /// For the triangle test, when the rays share their axis permutation.
+    sheared: Option<ShearedRays<L>>,
+    /// The rays that can travel in the packet: those with the fused box test's
+    /// constants (no axis they do not move along, every constant finite, `t_min ≥ 0`).
+    /// The others are traced alone.
+    ok: u32,
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn lanes8(rays: &[PreparedRay]) -> Lanes8 {
-    use std::arch::x86_64::*;
-    let pick = |f: &dyn Fn(&PreparedRay) -> f32| {
-        let mut v = [0f32; PACKET_RAYS];
-        for (i, x) in v.iter_mut().enumerate() {
-            *x = f(rays.get(i).unwrap_or(&rays[0]));
-        }
-        _mm256_loadu_ps(v.as_ptr())
-    };
-    Lanes8 {
-        origin: [0, 1, 2].map(|a| pick(&|r| r.ray.origin[a])),
-        inv: [0, 1, 2].map(|a| pick(&|r| r.inv_dir[a])),
-        inv_far: [0, 1, 2].map(|a| pick(&|r| r.inv_dir[a] * FAR_WIDENING)),
-        t_min: pick(&|r| r.ray.t_min),
-    }
-}
-
-/// Which rays of `active` enter child `c` of `node`, given each ray's search limit, and
-/// the entry distances.
-#[cfg(target_arch = "x86_64")]
+/// Makes the lanes of 1 to `L::N` rays, computing in lanes what [`PreparedRay::new`] and
+/// [`FmaOffsets::new`] compute ray by ray (the same operations, so the same bits).
 #[inline(always)]
-unsafe fn enters(
-    node: &WideNode,
-    c: usize,
-    l: &Lanes8,
-    limit: std::arch::x86_64::__m256,
-) -> (u32, std::arch::x86_64::__m256) {
-    use std::arch::x86_64::*;
-    let mut near = l.t_min;
-    let mut far = limit;
+unsafe fn packet_lanes<L: RayLanes>(rays: &[Ray]) -> PacketLanes<L> {
+    debug_assert!(!rays.is_empty() && rays.len() <= L::N);
+    let (stride, last) = (std::mem::size_of::<Ray>() / 4, rays.len() - 1);
+    let origin = (&rays[0].origin as *const crate::math::Vec3A).cast::<f32>();
+    let dir = (&rays[0].dir as *const crate::math::Vec3A).cast::<f32>();
+    let (zero, inf) = (L::splat(0.0), L::splat(f32::INFINITY));
+    let t_min = L::gather(&rays[0].t_min, stride, last);
+    let mut ok = L::ALL >> (L::N - rays.len()) & zero.le(t_min);
+    let (mut o, mut d, mut inv) = ([zero; 3], [zero; 3], [zero; 3]);
+    let (mut near_off, mut far_off, mut inv_far) = ([zero; 3], [zero; 3], [zero; 3]);
+    let mut negative = [0u32; 3];
     for a in 0..3 {
-        let lo = _mm256_sub_ps(_mm256_set1_ps(node.bounds[a][c]), l.origin[a]);
-        let hi = _mm256_sub_ps(_mm256_set1_ps(node.bounds[a + 3][c]), l.origin[a]);
-        let n = _mm256_min_ps(_mm256_mul_ps(lo, l.inv[a]), _mm256_mul_ps(hi, l.inv[a]));
-        let f = _mm256_max_ps(_mm256_mul_ps(lo, l.inv_far[a]), _mm256_mul_ps(hi, l.inv_far[a]));
-        near = _mm256_max_ps(n, near);
-        far = _mm256_min_ps(f, far);
+        o[a] = L::gather(origin.add(a), stride, last);
+        d[a] = L::gather(dir.add(a), stride, last);
+        inv[a] = L::splat(1.0).div(d[a]);
+        let p = o[a].mul(inv[a]);
+        let c = p.abs().mul(L::splat(FmaOffsets::OFFSET));
+        near_off[a] = p.add(c);
+        far_off[a] = p.sub(c);
+        inv_far[a] = inv[a].mul(L::splat(FmaOffsets::WIDENING));
+        ok &= !d[a].eq(zero);
+        for x in [o[a], inv[a], near_off[a], far_off[a], inv_far[a]] {
+            ok &= inf.gt(x.abs());
+        }
+        negative[a] = zero.gt(d[a]);
     }
-    let ok = _mm256_cmp_ps::<_CMP_LE_OQ>(near, far);
-    (_mm256_movemask_ps(ok) as u32, near)
+    let same = |m: u32| m & ok == 0 || m & ok == ok;
+    let rows = negative
+        .iter()
+        .all(|&m| same(m))
+        .then(|| [0, 1, 2].map(|a| if negative[a] & ok == 0 { (a, a + 3) } else { (a + 3, a) }));
+    // The dominant axis, as `max_abs_axis` picks it (ties to the later axis).
+    let [ax, ay, az] = [d[0].abs(), d[1].abs(), d[2].abs()];
+    let x_wins = ax.gt(ay) & ax.gt(az);
+    let y_wins = !ax.gt(ay) & ay.gt(az);
+    let kz = [x_wins, y_wins, !(x_wins | y_wins)].iter().position(|&m| m & ok == ok);
+    let sheared = match kz {
+        Some(kz) if ok != 0 && same(negative[kz]) => {
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            // Keep the winding of the projected triangle: swap when looking down −kz.
+            if negative[kz] & ok != 0 {
+                std::mem::swap(&mut kx, &mut ky);
+            }
+            let sz = inv[kz];
+            Some(ShearedRays {
+                k: [kx, ky, kz],
+                origin_k: [o[kx], o[ky], o[kz]],
+                shear: [d[kx].mul(sz), d[ky].mul(sz), sz],
+                t_min,
+            })
+        }
+        _ => None,
+    };
+    PacketLanes {
+        boxes: BoxLanes {
+            inv,
+            near_off,
+            inv_far,
+            far_off,
+            t_min,
+            rows,
+        },
+        sheared,
+        ok,
+    }
 }
 
-/// What a packet query does at a leaf for one ray: closest hit or any hit.
+impl<L: RayLanes> BoxLanes<L> {
+    /// Which rays enter child `c` of `node`, given each ray's search limit, and their
+    /// entry distances. `ROWS`: `self.rows` is known (each axis costs two fused
+    /// operations instead of four and a `min`/`max`).
+    #[inline(always)]
+    unsafe fn enters<const ROWS: bool>(&self, node: &WideNode, c: usize, limit: L) -> (u32, L) {
+        let mut near = self.t_min;
+        let mut far = limit;
+        for a in 0..3 {
+            let (n, f) = if ROWS {
+                let (near_row, far_row) = self.rows.unwrap_unchecked()[a];
+                (
+                    L::splat(node.bounds[near_row][c]).mul_sub(self.inv[a], self.near_off[a]),
+                    L::splat(node.bounds[far_row][c]).mul_sub(self.inv_far[a], self.far_off[a]),
+                )
+            } else {
+                let (lo, hi) = (L::splat(node.bounds[a][c]), L::splat(node.bounds[a + 3][c]));
+                (
+                    lo.mul_sub(self.inv[a], self.near_off[a])
+                        .min(hi.mul_sub(self.inv[a], self.near_off[a])),
+                    lo.mul_sub(self.inv_far[a], self.far_off[a])
+                        .max(hi.mul_sub(self.inv_far[a], self.far_off[a])),
+                )
+            };
+            near = n.max(near);
+            far = f.min(far);
+        }
+        (near.le(far), near)
+    }
+}
+
+/// What a packet query does with hits, for one ray: closest hit or any hit.
 pub trait PacketQuery {
     /// Per ray: the answer so far, and its search distance.
     type State: Copy;
-    fn start(r: &PreparedRay) -> Self::State;
+    fn start(r: &Ray) -> Self::State;
     /// The ray's current far limit.
     fn t_max(s: &Self::State) -> f32;
     /// Tests the leaf's packets; whether the ray is finished (an any-hit query found one).
@@ -106,6 +179,10 @@ pub trait PacketQuery {
         r: &PreparedRay,
         reference: u32,
     ) -> bool;
+    /// Takes a triangle hit within the ray's limits; whether the ray is finished.
+    fn record(s: &mut Self::State, hit: Hit) -> bool;
+    /// Tests primitive `id`, which is not a triangle; whether the ray is finished.
+    fn other<P: PrimitiveSet + ?Sized>(s: &mut Self::State, prims: &P, r: &PreparedRay, id: u32) -> bool;
 }
 
 pub struct ClosestQuery;
@@ -113,8 +190,8 @@ pub struct AnyQuery;
 
 impl PacketQuery for ClosestQuery {
     type State = (f32, Option<Hit>);
-    fn start(r: &PreparedRay) -> Self::State {
-        (r.ray.t_max, None)
+    fn start(r: &Ray) -> Self::State {
+        (r.t_max, None)
     }
     #[inline(always)]
     fn t_max(s: &Self::State) -> f32 {
@@ -133,12 +210,28 @@ impl PacketQuery for ClosestQuery {
         }
         false
     }
+    #[inline(always)]
+    fn record(s: &mut Self::State, hit: Hit) -> bool {
+        // The packet test's rule: nearer, or as near with a lower primitive index.
+        if Hit::is_closer_than(hit.t, hit.prim, &s.1) {
+            s.0 = hit.t;
+            s.1 = Some(hit);
+        }
+        false
+    }
+    #[inline(always)]
+    fn other<P: PrimitiveSet + ?Sized>(s: &mut Self::State, prims: &P, r: &PreparedRay, id: u32) -> bool {
+        match prims.intersect(id, r, s.0) {
+            Some(hit) => Self::record(s, hit),
+            None => false,
+        }
+    }
 }
 
 impl PacketQuery for AnyQuery {
     type State = (f32, bool);
-    fn start(r: &PreparedRay) -> Self::State {
-        (r.ray.t_max, false)
+    fn start(r: &Ray) -> Self::State {
+        (r.t_max, false)
     }
     #[inline(always)]
     fn t_max(s: &Self::State) -> f32 {
@@ -157,65 +250,166 @@ impl PacketQuery for AnyQuery {
         }
         s.1
     }
+    #[inline(always)]
+    fn record(s: &mut Self::State, _hit: Hit) -> bool {
+        s.1 = true;
+        true
+    }
+    #[inline(always)]
+    fn other<P: PrimitiveSet + ?Sized>(s: &mut Self::State, prims: &P, r: &PreparedRay, id: u32) -> bool {
+        s.1 |= prims.occludes(id, r, s.0);
+        s.1
+    }
 }
 
-/// Walks the packet `rays` (1 to 8 packable rays) through the tree; `states` start as
-/// [`PacketQuery::start`] and end as the answers.
+/// The set bits of a mask, lowest first.
+#[inline(always)]
+fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (m != 0).then(|| {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            i
+        })
+    })
+}
+
+/// A stack entry: a node (or leaf) reference, the rays that entered it, and the entry
+/// distance of the lowest of them (for the order of visits only).
+#[derive(Clone, Copy)]
+struct Entry {
+    reference: u32,
+    rays: u32,
+    key: f32,
+}
+
+/// The packet's rays prepared for the single-ray tests, each made when first needed
+/// (most rays of a coherent packet never need it).
+struct Prepared<'a> {
+    rays: &'a [Ray],
+    made: u32,
+    prepared: [MaybeUninit<PreparedRay>; MAX_PACKET],
+}
+
+impl Prepared<'_> {
+    #[inline(always)]
+    fn get(&mut self, i: usize) -> &PreparedRay {
+        if self.made & 1 << i == 0 {
+            self.prepared[i].write(PreparedRay::new(self.rays[i]));
+            self.made |= 1 << i;
+        }
+        // SAFETY: written above or earlier (its bit is set).
+        unsafe { self.prepared[i].assume_init_ref() }
+    }
+}
+
+/// Walks a packet of 1 to 8 rays through the tree with AVX2 lanes; returns the rays it
+/// did not take (to be traced alone).
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA; `nodes` and `packets` must be a tree built for `prims`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-pub unsafe fn traverse<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
+pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     nodes: &[WideNode],
     packets: &[Packet],
     prims: &P,
-    rays: &[PreparedRay],
+    rays: &[Ray],
     states: &mut [Q::State],
-) {
-    use std::arch::x86_64::*;
-    debug_assert!(!rays.is_empty() && rays.len() <= PACKET_RAYS && states.len() == rays.len());
-    let l = lanes8(rays);
-    let mut limits = [0f32; PACKET_RAYS];
+) -> u32 {
+    traverse::<super::ray_lanes::Rays8, Q, P>(nodes, packets, prims, rays, states)
+}
+
+/// Walks a packet of 1 to 16 rays through the tree with AVX-512 lanes; returns the rays
+/// it did not take (to be traced alone).
+///
+/// # Safety
+/// The CPU must have AVX-512 F, VL and BW, AVX2 and FMA; `nodes` and `packets` must be a
+/// tree built for `prims`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
+pub unsafe fn traverse_avx512<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
+    nodes: &[WideNode],
+    packets: &[Packet],
+    prims: &P,
+    rays: &[Ray],
+    states: &mut [Q::State],
+) -> u32 {
+    traverse::<super::ray_lanes::Rays16, Q, P>(nodes, packets, prims, rays, states)
+}
+
+/// Walks the packet `rays` (1 to `L::N` rays) through the tree; `states` start as
+/// [`PacketQuery::start`] and end as the answers, except for the rays returned, which
+/// cannot travel in a packet.
+#[inline(always)]
+unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
+    nodes: &[WideNode],
+    packets: &[Packet],
+    prims: &P,
+    rays: &[Ray],
+    states: &mut [Q::State],
+) -> u32 {
+    debug_assert!(!rays.is_empty() && rays.len() <= L::N && states.len() == rays.len());
+    let lanes = packet_lanes::<L>(rays);
+    let (l, sheared) = (&lanes.boxes, &lanes.sheared);
+    let all = L::ALL >> (L::N - rays.len());
+    let mut live = lanes.ok;
+    if live == 0 {
+        return all;
+    }
+    let mut prepared = Prepared {
+        rays,
+        made: 0,
+        prepared: [const { MaybeUninit::uninit() }; MAX_PACKET],
+    };
+    let mut limits = [0f32; MAX_PACKET];
     for (i, s) in states.iter().enumerate() {
         limits[i] = search_limit(Q::t_max(s));
     }
-    let mut limit = _mm256_loadu_ps(limits.as_ptr());
-    let mut live: u32 = (1u32 << rays.len()) - 1;
-    let mut stack = [std::mem::MaybeUninit::<(u32, u32)>::uninit(); STACK_SIZE];
+    let mut limit = L::load(limits.as_ptr());
+    let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK_SIZE];
     // Each entry's rays' entry distances: a ray that has since found a hit nearer than
     // its entry is dropped from the entry when it is popped.
-    let mut entry_near = [std::mem::MaybeUninit::<__m256>::uninit(); STACK_SIZE];
+    let mut entry_near = [const { MaybeUninit::<L>::uninit() }; STACK_SIZE];
     let mut sp = 1usize;
-    stack[0].write((0, live));
+    stack[0].write(Entry {
+        reference: 0,
+        rays: live,
+        key: 0.0,
+    });
     entry_near[0].write(l.t_min);
-    let mut near = [0f32; PACKET_RAYS];
+    let mut near = [0f32; MAX_PACKET];
     while sp > 0 {
         sp -= 1;
         // SAFETY: entries below `sp` were written.
-        let (reference, word) = stack[sp].assume_init();
-        let still = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(entry_near[sp].assume_init(), limit)) as u32;
-        let mask = word & 0xff & live & still;
+        let e = stack[sp].assume_init();
+        let mask = e.rays & live & entry_near[sp].assume_init().le(limit);
         if mask == 0 {
             continue;
         }
-        if reference & LEAF != 0 {
-            let mut bits = mask;
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                if Q::leaf(&mut states[i], packets, prims, &rays[i], reference) {
-                    live &= !(1 << i);
+        if e.reference & LEAF != 0 {
+            match sheared {
+                Some(sh) if mask.count_ones() >= LANE_LEAF_RAYS => {
+                    live &= !leaf_by_lanes::<L, Q, P>(sh, states, packets, prims, &mut prepared, e.reference, mask);
                 }
-                limits[i] = search_limit(Q::t_max(&states[i]));
+                _ => {
+                    for i in bits(mask) {
+                        if Q::leaf(&mut states[i], packets, prims, prepared.get(i), e.reference) {
+                            live &= !(1 << i);
+                        }
+                    }
+                }
             }
             if live == 0 {
-                return;
+                break;
             }
-            limit = _mm256_loadu_ps(limits.as_ptr());
+            for i in bits(mask) {
+                limits[i] = search_limit(Q::t_max(&states[i]));
+            }
+            limit = L::load(limits.as_ptr());
             continue;
         }
-        let node = &*nodes.as_ptr().cast::<u8>().add(reference as usize).cast::<WideNode>();
+        let node = &*nodes.as_ptr().cast::<u8>().add(e.reference as usize).cast::<WideNode>();
         // The children some active ray enters, keyed by the entry distance of the
         // lowest such ray, pushed farthest first.
         let base = sp;
@@ -224,34 +418,119 @@ pub unsafe fn traverse<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             if child == EMPTY {
                 continue;
             }
-            let (hits, n) = enters(node, c, &l, limit);
+            let (hits, n) = if l.rows.is_some() {
+                l.enters::<true>(node, c, limit)
+            } else {
+                l.enters::<false>(node, c, limit)
+            };
             let m = hits & mask;
             if m == 0 {
                 continue;
             }
-            _mm256_storeu_ps(near.as_mut_ptr(), n);
-            // Non-negative floats order like their bits; the low 8 bits carry the mask.
-            let key = near[m.trailing_zeros() as usize].max(0.0);
-            stack[sp].write((child, m | (key.to_bits() >> 8 << 8)));
+            n.store(near.as_mut_ptr());
+            stack[sp].write(Entry {
+                reference: child,
+                rays: m,
+                key: near[m.trailing_zeros() as usize],
+            });
             entry_near[sp].write(n);
             sp += 1;
         }
         // SAFETY: entries `base..sp` were written just above.
         sort_farthest_first(
-            std::slice::from_raw_parts_mut(stack.as_mut_ptr().add(base).cast::<(u32, u32)>(), sp - base),
-            std::slice::from_raw_parts_mut(entry_near.as_mut_ptr().add(base).cast::<__m256>(), sp - base),
+            std::slice::from_raw_parts_mut(stack.as_mut_ptr().add(base).cast::<Entry>(), sp - base),
+            std::slice::from_raw_parts_mut(entry_near.as_mut_ptr().add(base).cast::<L>(), sp - base),
         );
     }
+    all & !lanes.ok
 }
 
-/// Orders pushed entries (and their entry distances) by decreasing key (the high 24 bits
-/// of the second word; the low 8 are the ray mask).
+/// Tests the leaf `reference` for the rays of `mask`, one triangle against all of them at
+/// a time; returns the rays that are finished (any-hit queries that found one).
 #[inline(always)]
-fn sort_farthest_first<T: Copy>(e: &mut [(u32, u32)], near: &mut [T]) {
+unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
+    sh: &ShearedRays<L>,
+    states: &mut [Q::State],
+    packets: &[Packet],
+    prims: &P,
+    prepared: &mut Prepared,
+    reference: u32,
+    mask: u32,
+) -> u32 {
+    let mut t_max = [0f32; MAX_PACKET];
+    for i in bits(mask) {
+        t_max[i] = Q::t_max(&states[i]);
+    }
+    let mut t_max_lanes = L::load(t_max.as_ptr());
+    let mut active = mask;
+    let mut finished = 0;
+    let (mut t, mut v, mut w, mut inv_det) = (
+        [0f32; MAX_PACKET],
+        [0f32; MAX_PACKET],
+        [0f32; MAX_PACKET],
+        [0f32; MAX_PACKET],
+    );
+    for p in leaf_packets(reference) {
+        let packet = &packets[p];
+        for lane in 0..super::packet::LANES {
+            let changed = match packet.lane_kind(lane) {
+                LaneKind::Unused => break,
+                LaneKind::Other(id) => {
+                    for i in bits(active) {
+                        if Q::other(&mut states[i], prims, prepared.get(i), id) {
+                            finished |= 1 << i;
+                        }
+                    }
+                    active
+                }
+                LaneKind::Triangle(id) => {
+                    let h = ray_triangle::test(packet, lane, sh, t_max_lanes);
+                    let (accept, scalar) = (h.accept & active, h.scalar & active);
+                    if accept != 0 {
+                        h.t.store(t.as_mut_ptr());
+                        h.v.store(v.as_mut_ptr());
+                        h.w.store(w.as_mut_ptr());
+                        h.inv_det.store(inv_det.as_mut_ptr());
+                        for i in bits(accept) {
+                            let hit = Hit::new(t[i], id, v[i] * inv_det[i], w[i] * inv_det[i]);
+                            if Q::record(&mut states[i], hit) {
+                                finished |= 1 << i;
+                            }
+                        }
+                    }
+                    for i in bits(scalar) {
+                        let limit = Q::t_max(&states[i]);
+                        if let Some((t, b1, b2)) = packet.scalar_triangle(prepared.get(i), lane, limit) {
+                            if Q::record(&mut states[i], Hit::new(t, id, b1, b2)) {
+                                finished |= 1 << i;
+                            }
+                        }
+                    }
+                    accept | scalar
+                }
+            };
+            if changed != 0 {
+                active &= !finished;
+                if active == 0 {
+                    return finished;
+                }
+                for i in bits(changed) {
+                    t_max[i] = Q::t_max(&states[i]);
+                }
+                t_max_lanes = L::load(t_max.as_ptr());
+            }
+        }
+    }
+    finished
+}
+
+/// Orders pushed entries (and their entry distances) by decreasing key.
+#[inline(always)]
+fn sort_farthest_first<T: Copy>(e: &mut [Entry], near: &mut [T]) {
     for i in 1..e.len() {
         let (x, n) = (e[i], near[i]);
         let mut j = i;
-        while j > 0 && (e[j - 1].1 >> 8) < (x.1 >> 8) {
+        while j > 0 && e[j - 1].key < x.key {
             e[j] = e[j - 1];
             near[j] = near[j - 1];
             j -= 1;

@@ -100,14 +100,14 @@ impl RayBoxes {
 /// of this file checks every box test against f64 arithmetic on grazing rays.
 #[derive(Clone, Copy)]
 pub struct FmaOffsets {
-    near: [f32; 3],
-    far: [f32; 3],
-    inv_far: [f32; 3],
+    pub(super) near: [f32; 3],
+    pub(super) far: [f32; 3],
+    pub(super) inv_far: [f32; 3],
 }
 
 impl FmaOffsets {
-    const OFFSET: f32 = 1.0 / (1u32 << 18) as f32;
-    const WIDENING: f32 = 1.0 + 1.0 / (1u32 << 19) as f32;
+    pub(super) const OFFSET: f32 = 1.0 / (1u32 << 18) as f32;
+    pub(super) const WIDENING: f32 = 1.0 + 1.0 / (1u32 << 19) as f32;
 
     /// The constants, or `None` for rays that must take the plain test.
     #[inline(always)]
@@ -591,7 +591,7 @@ mod tests {
                 {
                     use super::super::lanes::{Avx, Sse};
                     check::<Slab<Sse>>("sse", &node, &r, &Slab::prepare(&rb), zero);
-                    if super::super::Isa::detect() == super::super::Isa::Avx2 {
+                    if super::super::Isa::detect().has_avx2() {
                         check::<Slab<Avx>>("avx", &node, &r, &Slab::prepare(&rb), zero);
                         if let Some(offsets) = FmaOffsets::new(&pr) {
                             check::<Fused<Avx>>("avx+fma", &node, &r, &Fused::prepare(&rb, &offsets), false);
@@ -601,7 +601,7 @@ mod tests {
                 }
             }
         }
-        if super::super::Isa::detect() == super::super::Isa::Avx2 {
+        if super::super::Isa::detect().has_avx2() {
             assert!(fused > 15_000, "{fused}");
         } else {
             eprintln!("note: no AVX2 and FMA here, the fused box test was not checked");
