@@ -132,6 +132,12 @@ impl Scene {
         self.geometry.occluded(ray)
     }
 
+    /// [`Scene::closest_hit`] of each of `rays` (`out[i]` for `rays[i]`): coherent rays,
+    /// such as the camera rays of a tile, travel through the BVH together.
+    pub fn closest_hits(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.geometry.closest_hits(rays, out)
+    }
+
     pub fn surface_point(&self, hit: &Hit, ray: &Ray) -> SurfacePoint {
         self.geometry.surface_point(hit, ray.origin, ray.dir)
     }

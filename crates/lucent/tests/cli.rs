@@ -209,6 +209,36 @@ fn same_bytes_for_any_thread_count_and_structure() {
 }
 
 #[test]
+fn camera_rays_in_packets_give_the_bytes_of_single_rays() {
+    // The BVH traces a tile's camera rays in packets (16 or 8 rays); the list traces
+    // them one by one. Triangles (tested across the rays of a packet), spheres (ray by
+    // ray), a plane (outside every structure), several samples per pixel, and both
+    // integrators.
+    let dir = workdir("packets");
+    let mut scene = String::from(SCENE);
+    scene += "vertex -1 -0.5 -1\nvertex 1 -0.5 -1\nvertex 0 0.5 -1.2\n";
+    for k in 0..40 {
+        let (x, y) = ((k % 8) as f32 - 3.5, (k / 8) as f32 * 0.5 - 1.0);
+        let z = -(k % 3) as f32;
+        scene += &format!("pushTransform\ntranslate {x} {y} {z}\ntri 3 4 5\npopTransform\n");
+        scene += &format!("sphere {} {y} -2 0.25\n", x + 0.3);
+    }
+    scene += "plane 0 -2.5 0 0 1 0\n";
+    fs::write(dir.join("s.test"), format!("{scene}spp 4\n")).unwrap();
+    let path = "spp 8\nintegrator pathtracer\nquadLight -1 3 -1 2 0 0 0 0 2 5 5 5\n";
+    fs::write(dir.join("p.test"), format!("{scene}{path}")).unwrap();
+    for s in ["s", "p"] {
+        for accel in ["bvh", "list"] {
+            let out = format!("{s}-{accel}.png");
+            let o = lucent(&dir, &["render", &format!("{s}.test"), "-q", "-o", &out, "--accel", accel]);
+            assert!(o.status.success(), "{}", stderr(&o));
+        }
+        let bvh = fs::read(dir.join(format!("{s}-bvh.png"))).unwrap();
+        assert_eq!(bvh, fs::read(dir.join(format!("{s}-list.png"))).unwrap(), "{s}");
+    }
+}
+
+#[test]
 fn an_empty_scene_renders_black() {
     let dir = workdir("empty");
     fs::write(dir.join("e.test"), "size 8 6\ncamera 0 0 -1 0 0 1 0 1 0 60\n").unwrap();

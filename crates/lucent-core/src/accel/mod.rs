@@ -20,7 +20,7 @@ pub(crate) mod test_sets;
 use crate::aabb::Aabb;
 use crate::hit::Hit;
 use crate::math::Vec3A;
-use crate::ray::PreparedRay;
+use crate::ray::{PreparedRay, Ray};
 
 /// How far past the closest hit so far a structure keeps looking.
 ///
@@ -76,6 +76,14 @@ pub trait Accelerator<P: PrimitiveSet + ?Sized>: Send + Sync {
     fn occluded(&self, prims: &P, r: &PreparedRay) -> bool;
     /// Bytes used by the structure itself (not counting the primitives).
     fn memory_bytes(&self) -> usize;
+    /// The closest hits of many rays (`out[i]` for `rays[i]`), the same as
+    /// [`Accelerator::closest_hit`] ray by ray; a structure that traces coherent rays
+    /// together (the BVH's packets) does so here.
+    fn closest_hits(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = self.closest_hit(prims, &PreparedRay::new(*r));
+        }
+    }
 }
 
 /// The structures `lucent render --accel` offers.

@@ -47,6 +47,25 @@ impl Geometry {
         best
     }
 
+    /// [`Geometry::closest_hit`] of each of `rays` (`out[i]` for `rays[i]`), coherent
+    /// rays together (see [`Accelerator::closest_hits`]).
+    pub fn closest_hits(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.accel.closest_hits(&self.primitives, rays, out);
+        if !self.unbounded.is_empty() {
+            for (best, ray) in out.iter_mut().zip(rays) {
+                let r = PreparedRay::new(*ray);
+                for &i in &self.unbounded {
+                    let t_max = best.map_or(ray.t_max, |b| b.t);
+                    if let Some(hit) = self.primitives[i as usize].intersect(i, &r, t_max) {
+                        if Hit::is_closer_than(hit.t, i, best) {
+                            *best = Some(hit);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let r = PreparedRay::new(*ray);

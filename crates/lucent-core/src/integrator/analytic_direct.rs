@@ -14,7 +14,7 @@
 
 use std::f32::consts::FRAC_1_PI;
 
-use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
+use super::{first_hit, CameraHit, FirstHit, Integrator, PixelSampling, TraceCounts};
 use crate::hit::BACKGROUND;
 use crate::light::{Light, QuadLight};
 use crate::math::{Color, DVec3, Vec3A};
@@ -41,8 +41,15 @@ pub fn irradiance_vector(q: &QuadLight, x: Vec3A) -> Vec3A {
 }
 
 impl Integrator for AnalyticDirect {
-    fn radiance(&self, scene: &Scene, ray: &Ray, _sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
-        let (hit, sp) = match first_hit(scene, ray, counts) {
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        mut camera: CameraHit,
+        _sampler: &mut Sampler,
+        counts: &mut TraceCounts,
+    ) -> Color {
+        let (hit, sp) = match first_hit(scene, ray, &mut camera, counts) {
             FirstHit::Nothing => return BACKGROUND,
             FirstHit::Light(radiance) => return radiance,
             FirstHit::Surface(hit, sp) => (hit, sp),

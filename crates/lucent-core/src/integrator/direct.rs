@@ -19,7 +19,7 @@
 //! direct light is estimated where it lands (what pbrt's direct-lighting integrator does).
 
 use super::light_sampling::every_light;
-use super::{first_hit, FirstHit, Integrator, PixelSampling, TraceCounts};
+use super::{first_hit, CameraHit, FirstHit, Integrator, PixelSampling, TraceCounts};
 use crate::math::Color;
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -35,12 +35,19 @@ pub struct Direct {
 }
 
 impl Integrator for Direct {
-    fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
+    fn radiance(
+        &self,
+        scene: &Scene,
+        camera_ray: &Ray,
+        mut camera: CameraHit,
+        sampler: &mut Sampler,
+        counts: &mut TraceCounts,
+    ) -> Color {
         let mut ray = *camera_ray;
         let mut weight = Color::ONE;
         let mut total = Color::ZERO;
         for bounce in 0.. {
-            let (hit, sp) = match first_hit(scene, &ray, counts) {
+            let (hit, sp) = match first_hit(scene, &ray, &mut camera, counts) {
                 FirstHit::Nothing => return total + weight * scene.background(ray.dir),
                 FirstHit::Light(radiance) => return total + weight * radiance,
                 FirstHit::Surface(hit, sp) => (hit, sp),

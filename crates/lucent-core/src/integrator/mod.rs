@@ -41,6 +41,29 @@ pub enum PixelSampling {
     Uniform,
 }
 
+/// The closest hit of a camera ray, when the renderer has traced it already: camera rays
+/// of a tile travel through the BVH together, in packets.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum CameraHit {
+    /// Not traced yet: the integrator traces it.
+    #[default]
+    Untraced,
+    Traced(Option<Hit>),
+}
+
+impl CameraHit {
+    /// The closest hit of `ray` (counting the ray): the one found already, else traced.
+    /// Leaves `self` untraced, so that it serves the camera ray only.
+    #[inline]
+    pub fn take(&mut self, scene: &Scene, ray: &Ray, counts: &mut TraceCounts) -> Option<Hit> {
+        counts.rays += 1;
+        match std::mem::take(self) {
+            CameraHit::Traced(hit) => hit,
+            CameraHit::Untraced => scene.closest_hit(ray),
+        }
+    }
+}
+
 /// What a camera ray meets, for the integrators that look at one surface: nothing, a
 /// light (the radiance it shows the ray: its front's, black from behind) or an ordinary
 /// surface point.
@@ -50,10 +73,9 @@ pub(crate) enum FirstHit {
     Surface(Hit, SurfacePoint),
 }
 
-/// Traces `ray` (counting it) and says what it meets.
-pub(crate) fn first_hit(scene: &Scene, ray: &Ray, counts: &mut TraceCounts) -> FirstHit {
-    counts.rays += 1;
-    let Some(hit) = scene.closest_hit(ray) else {
+/// Traces `ray` (counting it; `camera` may hold its hit already) and says what it meets.
+pub(crate) fn first_hit(scene: &Scene, ray: &Ray, camera: &mut CameraHit, counts: &mut TraceCounts) -> FirstHit {
+    let Some(hit) = camera.take(scene, ray, counts) else {
         return FirstHit::Nothing;
     };
     let sp = scene.surface_point(&hit, ray);
@@ -64,9 +86,17 @@ pub(crate) fn first_hit(scene: &Scene, ray: &Ray, counts: &mut TraceCounts) -> F
 }
 
 pub trait Integrator: Sync {
-    /// Radiance arriving along `ray`; `sampler` gives the sample's random numbers, and
-    /// `counts` counts what was traced on the way.
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color;
+    /// Radiance arriving along the camera ray `ray` (whose closest hit `camera` may hold
+    /// already); `sampler` gives the sample's random numbers, and `counts` counts what
+    /// was traced on the way.
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        camera: CameraHit,
+        sampler: &mut Sampler,
+        counts: &mut TraceCounts,
+    ) -> Color;
 
     fn pixel_sampling(&self) -> PixelSampling {
         PixelSampling::Stratified

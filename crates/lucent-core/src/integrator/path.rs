@@ -29,7 +29,7 @@
 //! roulette, when about to go on, ends the path with probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
 
 use super::light_sampling::{every_light, one_light_mis};
-use super::{Integrator, PixelSampling, TraceCounts};
+use super::{CameraHit, Integrator, PixelSampling, TraceCounts};
 use crate::hit::SurfacePoint;
 use crate::math::{Color, Vec3A};
 use crate::ray::Ray;
@@ -169,7 +169,14 @@ enum Came {
 }
 
 impl Integrator for PathTracer {
-    fn radiance(&self, scene: &Scene, camera_ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
+    fn radiance(
+        &self,
+        scene: &Scene,
+        camera_ray: &Ray,
+        mut camera: CameraHit,
+        sampler: &mut Sampler,
+        counts: &mut TraceCounts,
+    ) -> Color {
         let mut total = Color::ZERO;
         let mut beta = Color::ONE;
         let mut ray = *camera_ray;
@@ -177,8 +184,7 @@ impl Integrator for PathTracer {
         // The index of the vertex the current segment will hit.
         let mut k = 1u32;
         loop {
-            counts.rays += 1;
-            let Some(hit) = scene.closest_hit(&ray) else {
+            let Some(hit) = camera.take(scene, &ray, counts) else {
                 // The environment (black without one), a light like any other.
                 if let Some(env) = &scene.environment {
                     let le = env.radiance(ray.dir);

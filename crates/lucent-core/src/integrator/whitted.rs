@@ -36,7 +36,7 @@
 //! can no longer show is not traced (adaptive depth control, [`super::depth`]).
 
 use super::depth::DepthControl;
-use super::{Integrator, TraceCounts};
+use super::{CameraHit, Integrator, TraceCounts};
 use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::light::Light;
 use crate::math::{Color, Vec3A};
@@ -53,6 +53,8 @@ const MIN_WEIGHT: f32 = 1.0 / 2048.0;
 /// What one camera sample's ray tree shares.
 struct Tracing<'a> {
     scene: &'a Scene,
+    /// The camera ray's closest hit, if the renderer traced it already.
+    camera: CameraHit,
     sampler: &'a mut Sampler,
     counts: &'a mut TraceCounts,
     /// What left-out branches could have added (adaptive depth control's spending).
@@ -101,8 +103,7 @@ impl Whitted {
     /// hit; `None` when the ray escapes.
     fn shade(&self, t: &mut Tracing, ray: &Ray) -> Option<(Color, SurfacePoint)> {
         let scene = t.scene;
-        t.counts.rays += 1;
-        let hit = scene.closest_hit(ray)?;
+        let hit = t.camera.take(scene, ray, t.counts)?;
         let mut sp = scene.surface_point(&hit, ray);
         if let Some(light) = sp.light {
             return Some((scene.lights[light as usize].radiance_seen(ray.dir, sp.normal), sp));
@@ -333,10 +334,18 @@ fn push(pending: &mut Vec<Branch>, b: Branch, counts: &mut TraceCounts) {
 }
 
 impl Integrator for Whitted {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut Sampler, counts: &mut TraceCounts) -> Color {
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        camera: CameraHit,
+        sampler: &mut Sampler,
+        counts: &mut TraceCounts,
+    ) -> Color {
         let mut total = BACKGROUND;
         let mut t = Tracing {
             scene,
+            camera,
             sampler,
             counts,
             dropped: 0.0,

@@ -20,7 +20,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use crate::film::{AovSum, ExactSum, Film, PixelNoise};
-use crate::integrator::{Integrator, PixelSampling, TraceCounts};
+use crate::integrator::{CameraHit, Integrator, PixelSampling, TraceCounts};
+use crate::ray::Ray;
 use crate::math::Color;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
@@ -222,6 +223,20 @@ pub fn render_after(
 
 /// The sums of the samples of one tile's pixels and how many each took; `None` as soon
 /// as `cancel` is set (it is looked at between pixels and every [`CANCEL_EVERY`] samples).
+/// Camera samples made ahead and finished together: up to this many, in the tile's
+/// order, have their camera rays traced at once (in packets, [`Scene::closest_hits`]).
+const CAMERA_BATCH: usize = 64;
+
+/// A camera sample made, waiting for its ray's closest hit.
+struct CameraSample {
+    /// The pixel's index in the tile (reading order).
+    pixel: usize,
+    x: u32,
+    y: u32,
+    /// The sampler, past the numbers the camera drew.
+    sampler: Sampler,
+}
+
 fn render_tile(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -230,37 +245,89 @@ fn render_tile(
     tile: &Tile,
     cancel: &AtomicBool,
 ) -> Option<(TilePixels, RenderStats)> {
-    let mut pixels = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
     let mut counts = TraceCounts::default();
     let mut bad_samples = 0;
     let mut bad_pixels = BadPixels::default();
-    let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
     let n = job.spp.max(1);
     let sampling = integrator.pixel_sampling();
     // Shuffled lens strata need a table of `spp` entries: beyond MAX_LENS_STRATA samples
     // per pixel (where stratifying them no longer matters) lens samples are independent.
     let shuffle_lens = scene.camera.has_lens() && n <= MAX_LENS_STRATA;
     let mut lens_strata: Vec<u32> = Vec::new();
+    // Each pixel's sums; adaptive sampling goes on from the earlier samples' estimate.
+    let mut pixels: Vec<PixelResult> = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
+    let mut before = Vec::with_capacity(pixels.capacity());
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
-            if shuffle_lens {
-                lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
-            }
-            let mut sum = ExactSum::default();
-            let mut aov = AovSum::default();
-            let mut taken = 0u32;
-            // Adaptive sampling goes on from the earlier samples' estimate.
-            let (mut noise, before) = match earlier {
+            let (noise, b) = match earlier {
                 Some(f) => {
                     let k = (y - job.pixels.y0) as usize * job.pixels.width() as usize + (x - job.pixels.x0) as usize;
                     (f.noise.as_ref().map_or(PixelNoise::default(), |n| n[k]), f.counts[k])
                 }
                 None => (PixelNoise::default(), 0),
             };
-            let samples = if noise.stopped { 0..0 } else { job.samples.clone() };
-            for i in samples {
+            pixels.push(PixelResult {
+                sum: ExactSum::default(),
+                taken: 0,
+                aov: AovSum::default(),
+                noise,
+            });
+            before.push(b);
+        }
+    }
+    // Samples are made in the tile's order, pixel by pixel, and finished in the same
+    // order, so every pixel's sums and stopping point are what one sample at a time
+    // gives. Adaptive sampling decides after each sample whether its pixel takes the
+    // next: one at a time there.
+    let batch = if job.noise_threshold.is_some() { 1 } else { CAMERA_BATCH };
+    let mut made: Vec<CameraSample> = Vec::with_capacity(batch);
+    let mut rays: Vec<Ray> = Vec::with_capacity(batch);
+    let mut hits = vec![None; batch];
+    let mut finish = |made: &mut Vec<CameraSample>, rays: &mut Vec<Ray>, pixels: &mut [PixelResult]| {
+        if batch > 1 {
+            scene.closest_hits(rays, &mut hits[..rays.len()]);
+        }
+        for (k, (s, ray)) in made.drain(..).zip(rays.drain(..)).enumerate() {
+            let camera = if batch > 1 { CameraHit::Traced(hits[k]) } else { CameraHit::Untraced };
+            let mut sampler = s.sampler;
+            let p = &mut pixels[s.pixel];
+            if job.aovs {
+                p.aov.add_sample(&aov::first_surface(scene, &ray, &mut counts));
+            }
+            let c = integrator.radiance(scene, &ray, camera, &mut sampler, &mut counts);
+            let c = if c.is_finite() {
+                c
+            } else {
+                bad_samples += 1;
+                bad_pixels.note((s.x, s.y));
+                Color::ZERO
+            };
+            // The box filter: every sample of the pixel counts the same.
+            p.sum.add_sample(c);
+            p.taken += 1;
+            if let Some(threshold) = job.noise_threshold {
+                p.noise.add(c);
+                // Looked at every 8 samples: a stop then leaves whole 8-point nets of
+                // the Sobol sequences, which cover the pixel evenly.
+                let all = before[s.pixel] + p.taken;
+                if all >= MIN_ADAPTIVE_SAMPLES.min(n) && all % 8 == 0 && p.noise.relative_error(all) < threshold as f64 {
+                    p.noise.stopped = true;
+                }
+            }
+        }
+    };
+    let mut pixel = 0;
+    for y in tile.y0..tile.y1 {
+        for x in tile.x0..tile.x1 {
+            if shuffle_lens {
+                lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
+            }
+            for i in job.samples.clone() {
                 if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
+                }
+                if pixels[pixel].noise.stopped {
+                    break;
                 }
                 let mut sampler = Sampler::start(job.sampler, job.seed, x, y, i);
                 let (dx, dy) = match sampling {
@@ -293,42 +360,26 @@ fn render_tile(
                 } else {
                     (0.5, 0.5)
                 };
-                let ray = scene
-                    .camera
-                    .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens);
-                if job.aovs {
-                    aov.add_sample(&aov::first_surface(scene, &ray, &mut counts));
-                }
-                let c = integrator.radiance(scene, &ray, &mut sampler, &mut counts);
-                let c = if c.is_finite() {
-                    c
-                } else {
-                    bad_samples += 1;
-                    bad_pixels.note((x, y));
-                    Color::ZERO
-                };
-                // The box filter: every sample of the pixel counts the same.
-                sum.add_sample(c);
-                taken += 1;
-                if let Some(threshold) = job.noise_threshold {
-                    noise.add(c);
-                    // Looked at every 8 samples: a stop then leaves whole 8-point nets of
-                    // the Sobol sequences, which cover the pixel evenly.
-                    let all = before + taken;
-                    if all >= MIN_ADAPTIVE_SAMPLES.min(n)
-                        && all % 8 == 0
-                        && noise.relative_error(all) < threshold as f64
-                    {
-                        noise.stopped = true;
-                        break;
-                    }
+                rays.push(
+                    scene
+                        .camera
+                        .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens),
+                );
+                made.push(CameraSample { pixel, x, y, sampler });
+                if made.len() == batch {
+                    finish(&mut made, &mut rays, &mut pixels);
                 }
             }
-            pixels.push(PixelResult { sum, taken, aov, noise });
-            taken_min = taken_min.min(taken);
-            taken_max = taken_max.max(taken);
-            taken_all += taken as u64;
+            pixel += 1;
         }
+    }
+    finish(&mut made, &mut rays, &mut pixels);
+    drop(finish);
+    let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
+    for p in &pixels {
+        taken_min = taken_min.min(p.taken);
+        taken_max = taken_max.max(p.taken);
+        taken_all += p.taken as u64;
     }
     let stats = RenderStats {
         rays: counts.rays,

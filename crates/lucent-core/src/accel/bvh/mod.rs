@@ -148,7 +148,7 @@ impl Bvh {
         &self,
         prims: &P,
         rays: &[Ray],
-        mut answer: impl FnMut(usize, Q::State),
+        mut answer: impl FnMut(usize, &Q::State),
         single: impl Fn(&Ray) -> Q::State,
     ) {
         let width = self.packet_rays();
@@ -170,13 +170,16 @@ impl Bvh {
                         ray_packet::traverse_avx2::<Q, P>(nodes, packets, prims, chunk, states)
                     }
                 };
+                for i in ray_packet::bits(alone) {
+                    states[i] = single(&chunk[i]);
+                }
                 for (i, s) in states.iter().enumerate() {
-                    answer(base + i, if alone & 1 << i != 0 { single(&chunk[i]) } else { *s });
+                    answer(base + i, s);
                 }
                 continue;
             }
             for (i, r) in chunk.iter().enumerate() {
-                answer(base + i, single(r));
+                answer(base + i, &single(r));
             }
         }
     }
@@ -306,6 +309,10 @@ impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
 
     fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<WideNode>() + self.packets.len() * std::mem::size_of::<Packet>()
+    }
+
+    fn closest_hits(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
+        Bvh::closest_hits(self, prims, rays, out)
     }
 }
 

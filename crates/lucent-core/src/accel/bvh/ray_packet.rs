@@ -264,7 +264,7 @@ impl PacketQuery for AnyQuery {
 
 /// The set bits of a mask, lowest first.
 #[inline(always)]
-fn bits(mut m: u32) -> impl Iterator<Item = usize> {
+pub(super) fn bits(mut m: u32) -> impl Iterator<Item = usize> {
     std::iter::from_fn(move || {
         (m != 0).then(|| {
             let i = m.trailing_zeros() as usize;
@@ -484,8 +484,8 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                     active
                 }
                 LaneKind::Triangle(id) => {
-                    let h = ray_triangle::test(packet, lane, sh, t_max_lanes);
-                    let (accept, scalar) = (h.accept & active, h.scalar & active);
+                    let h = ray_triangle::test(packet, lane, sh, t_max_lanes, active);
+                    let (accept, scalar) = (h.accept, h.scalar);
                     if accept != 0 {
                         h.t.store(t.as_mut_ptr());
                         h.v.store(v.as_mut_ptr());

@@ -42,10 +42,16 @@ pub struct TriangleLanes<L> {
 }
 
 /// Tests the triangle in lane `lane` of `packet` (a triangle, not another primitive)
-/// against every lane of `rays`, each against its own `t_max`.
+/// against the rays `active` of `rays`, each against its own `t_max`. Only the returned
+/// masks are meaningful for rays outside `active`.
 #[inline(always)]
-pub unsafe fn test<L: RayLanes>(packet: &Packet, lane: usize, rays: &ShearedRays<L>, t_max: L) -> TriangleLanes<L> {
-    let sz = rays.shear[2];
+pub unsafe fn test<L: RayLanes>(
+    packet: &Packet,
+    lane: usize,
+    rays: &ShearedRays<L>,
+    t_max: L,
+    active: u32,
+) -> TriangleLanes<L> {
     let (ax, ay, az) = project(packet, 0, lane, rays);
     let (bx, by, bz) = project(packet, 1, lane, rays);
     let (cx, cy, cz) = project(packet, 2, lane, rays);
@@ -53,15 +59,27 @@ pub unsafe fn test<L: RayLanes>(packet: &Packet, lane: usize, rays: &ShearedRays
     let v = ax.mul(cy).sub(ay.mul(cx));
     let w = bx.mul(ay).sub(by.mul(ax));
     let zero = L::splat(0.0);
-    let scalar = u.eq(zero) | v.eq(zero) | w.eq(zero);
+    let scalar = (u.eq(zero) | v.eq(zero) | w.eq(zero)) & active;
     // With no zero among them, the edge functions agree in sign exactly when the sign
     // bits of `u ^ v` and `u ^ w` are clear.
-    let mixed = u.xor(v).or(u.xor(w)).sign_bits();
+    let inside = !u.xor(v).or(u.xor(w)).sign_bits() & !scalar & active;
+    if inside == 0 {
+        // Most rays that reach a leaf miss most of its triangles: no division for them.
+        return TriangleLanes {
+            accept: 0,
+            scalar,
+            t: zero,
+            v,
+            w,
+            inv_det: zero,
+        };
+    }
     let det = u.add(v).add(w);
+    let sz = rays.shear[2];
     let t_scaled = u.mul(sz.mul(az)).add(v.mul(sz.mul(bz))).add(w.mul(sz.mul(cz)));
     let inv_det = L::splat(1.0).div(det);
     let t = t_scaled.mul(inv_det);
-    let accept = !det.eq(zero) & t.gt(rays.t_min) & t.le(t_max) & !mixed & !scalar & L::ALL;
+    let accept = !det.eq(zero) & t.gt(rays.t_min) & t.le(t_max) & inside;
     TriangleLanes {
         accept,
         scalar,
