@@ -230,7 +230,10 @@ fn camera_rays_in_packets_give_the_bytes_of_single_rays() {
     for s in ["s", "p"] {
         for accel in ["bvh", "list"] {
             let out = format!("{s}-{accel}.png");
-            let o = lucent(&dir, &["render", &format!("{s}.test"), "-q", "-o", &out, "--accel", accel]);
+            let o = lucent(
+                &dir,
+                &["render", &format!("{s}.test"), "-q", "-o", &out, "--accel", accel],
+            );
             assert!(o.status.success(), "{}", stderr(&o));
         }
         let bvh = fs::read(dir.join(format!("{s}-bvh.png"))).unwrap();

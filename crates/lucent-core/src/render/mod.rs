@@ -21,8 +21,8 @@ use rayon::prelude::*;
 
 use crate::film::{AovSum, ExactSum, Film, PixelNoise};
 use crate::integrator::{CameraHit, Integrator, PixelSampling, TraceCounts};
-use crate::ray::Ray;
 use crate::math::Color;
+use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
 use job::{RenderJob, MIN_ADAPTIVE_SAMPLES};
@@ -288,7 +288,11 @@ fn render_tile(
             scene.closest_hits(rays, &mut hits[..rays.len()]);
         }
         for (k, (s, ray)) in made.drain(..).zip(rays.drain(..)).enumerate() {
-            let camera = if batch > 1 { CameraHit::Traced(hits[k]) } else { CameraHit::Untraced };
+            let camera = if batch > 1 {
+                CameraHit::Traced(hits[k])
+            } else {
+                CameraHit::Untraced
+            };
             let mut sampler = s.sampler;
             let p = &mut pixels[s.pixel];
             if job.aovs {
@@ -310,7 +314,8 @@ fn render_tile(
                 // Looked at every 8 samples: a stop then leaves whole 8-point nets of
                 // the Sobol sequences, which cover the pixel evenly.
                 let all = before[s.pixel] + p.taken;
-                if all >= MIN_ADAPTIVE_SAMPLES.min(n) && all % 8 == 0 && p.noise.relative_error(all) < threshold as f64 {
+                if all >= MIN_ADAPTIVE_SAMPLES.min(n) && all % 8 == 0 && p.noise.relative_error(all) < threshold as f64
+                {
                     p.noise.stopped = true;
                 }
             }

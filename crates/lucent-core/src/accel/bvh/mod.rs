@@ -33,8 +33,10 @@ use wide::WideNode;
 /// The instruction set the traversal uses on this CPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
-    /// AVX-512 F, VL and BW (with AVX2 and FMA): single rays as with AVX2, packets of
-    /// sixteen rays.
+    /// AVX-512 F, VL and BW (with AVX2 and FMA): packets of sixteen rays; single rays
+    /// take the AVX2 path (compiled for AVX-512 it was no faster: a single ray's
+    /// traversal is bound by the latency of each node visit, not by instructions or
+    /// registers).
     Avx512,
     /// AVX2 with FMA (every AVX2 CPU has both): packets of eight rays.
     Avx2,

@@ -166,6 +166,10 @@ impl<L: RayLanes> BoxLanes<L> {
 
 /// What a packet query does with hits, for one ray: closest hit or any hit.
 pub trait PacketQuery {
+    /// Whether a ray's search distance shrinks as hits are found (closest hits): then
+    /// children are visited nearest first and each entry keeps its rays' entry distances
+    /// to drop rays that have found something nearer. Any-hit queries need neither.
+    const SHRINKS: bool;
     /// Per ray: the answer so far, and its search distance.
     type State: Copy;
     fn start(r: &Ray) -> Self::State;
@@ -189,6 +193,7 @@ pub struct ClosestQuery;
 pub struct AnyQuery;
 
 impl PacketQuery for ClosestQuery {
+    const SHRINKS: bool = true;
     type State = (f32, Option<Hit>);
     fn start(r: &Ray) -> Self::State {
         (r.t_max, None)
@@ -229,6 +234,7 @@ impl PacketQuery for ClosestQuery {
 }
 
 impl PacketQuery for AnyQuery {
+    const SHRINKS: bool = false;
     type State = (f32, bool);
     fn start(r: &Ray) -> Self::State {
         (r.t_max, false)
@@ -377,13 +383,18 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
         rays: live,
         key: 0.0,
     });
-    entry_near[0].write(l.t_min);
+    if Q::SHRINKS {
+        entry_near[0].write(l.t_min);
+    }
     let mut near = [0f32; MAX_PACKET];
     while sp > 0 {
         sp -= 1;
         // SAFETY: entries below `sp` were written.
         let e = stack[sp].assume_init();
-        let mask = e.rays & live & entry_near[sp].assume_init().le(limit);
+        let mut mask = e.rays & live;
+        if Q::SHRINKS {
+            mask &= entry_near[sp].assume_init().le(limit);
+        }
         if mask == 0 {
             continue;
         }
@@ -427,20 +438,27 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             if m == 0 {
                 continue;
             }
-            n.store(near.as_mut_ptr());
+            let key = if Q::SHRINKS {
+                n.store(near.as_mut_ptr());
+                entry_near[sp].write(n);
+                near[m.trailing_zeros() as usize]
+            } else {
+                0.0
+            };
             stack[sp].write(Entry {
                 reference: child,
                 rays: m,
-                key: near[m.trailing_zeros() as usize],
+                key,
             });
-            entry_near[sp].write(n);
             sp += 1;
         }
-        // SAFETY: entries `base..sp` were written just above.
-        sort_farthest_first(
-            std::slice::from_raw_parts_mut(stack.as_mut_ptr().add(base).cast::<Entry>(), sp - base),
-            std::slice::from_raw_parts_mut(entry_near.as_mut_ptr().add(base).cast::<L>(), sp - base),
-        );
+        if Q::SHRINKS {
+            // SAFETY: entries `base..sp` were written just above.
+            sort_farthest_first(
+                std::slice::from_raw_parts_mut(stack.as_mut_ptr().add(base).cast::<Entry>(), sp - base),
+                std::slice::from_raw_parts_mut(entry_near.as_mut_ptr().add(base).cast::<L>(), sp - base),
+            );
+        }
     }
     all & !lanes.ok
 }
