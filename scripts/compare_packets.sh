@@ -100,4 +100,4 @@ for name in names:
 print(f"\n(Mrays per CPU-second, {threads} thread(s), median of {rounds} interleaved rounds [min-max]; "
       f"ratio = lucent / the faster Embree packet width, paired by round; mismatches against the Embree 3 reference)")
 PY
-echo "CPU: $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1); $(grep -o 'avx512[a-z]*' /proc/cpuinfo 2>/dev/null | sort -u | tr '\n' ' ')"
+echo "CPU: $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1); $(grep -o 'avx512[a-z_0-9]*' /proc/cpuinfo 2>/dev/null | sort -u | tr '\n' ' ')"

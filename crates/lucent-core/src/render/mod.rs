@@ -379,7 +379,6 @@ fn render_tile(
         }
     }
     finish(&mut made, &mut rays, &mut pixels);
-    drop(finish);
     let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
     for p in &pixels {
         taken_min = taken_min.min(p.taken);

@@ -390,6 +390,19 @@ mod tests {
         for k in 0..16 {
             rays.push(Ray::new(Vec3A::new(k as f32 - 8.0, 0.5, -40.0), Vec3A::Z));
         }
+        // Packets that mix rays the packet can take with rays it cannot (an axis they do
+        // not move along, a negative t_min, a NaN direction): the latter are traced alone.
+        for y in 0..8 {
+            for x in 0..16 {
+                let d = Vec3A::new(x as f32 / 8.0 - 1.0, y as f32 / 4.0 - 1.0, 1.0).normalize();
+                rays.push(match (x + y) % 7 {
+                    0 => Ray::new(eye, Vec3A::new(0.0, d.y, d.z).normalize()),
+                    3 => Ray::segment(eye, d, -1.0, f32::INFINITY),
+                    5 if y == 2 => Ray::new(eye, Vec3A::new(f32::NAN, 0.0, 1.0)),
+                    _ => Ray::new(eye, d),
+                });
+            }
+        }
         let prepared: Vec<PreparedRay> = rays.iter().copied().map(PreparedRay::new).collect();
         let mut hits = vec![None; prepared.len()];
         bvh.closest_hits(&prims, &rays, &mut hits);
