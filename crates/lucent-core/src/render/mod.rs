@@ -182,42 +182,52 @@ pub fn render_after(
     // the progress callback's rate gives is honest from the first tiles on; where a
     // tile's pixels land does not depend on it.
     let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
-    let results: Vec<Option<(TilePixels, RenderStats)>> = order
-        .par_iter()
-        .map(|&t| {
-            if control.cancel.load(Ordering::Relaxed) {
-                return None;
-            }
-            let out = render_tile(scene, integrator, job, earlier, &tiles[t as usize], control.cancel)?;
-            (control.progress)(out.0.len() as u64 * job.samples.len() as u64);
-            Some(out)
-        })
-        .collect();
-
     let w = rect.width() as usize;
     let mut film = Film::with_aovs(rect.width(), rect.height(), job.aovs);
     if job.noise_threshold.is_some() {
         film.noise = Some(vec![PixelNoise::default(); film.counts.len()]);
     }
-    let mut stats = RenderStats {
+    let stats = RenderStats {
         min_pixel_samples: u32::MAX,
         ..RenderStats::default()
     };
-    for (&t, result) in order.iter().zip(results) {
-        let tile = &tiles[t as usize];
-        let (pixels, s) = result?;
-        stats.add(&s);
-        let tw = (tile.x1 - tile.x0) as usize;
-        for (row, chunk) in pixels.chunks(tw).enumerate() {
-            let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
-            for (i, p) in chunk.iter().enumerate() {
-                film.add(start + i, &p.sum, p.taken, &p.aov);
-                if let Some(noise) = &mut film.noise {
-                    noise[start + i] = p.noise;
+    // Each finished tile is added to the film at once (exact sums, and counts that add
+    // up: the same film in any order), rather than kept until the end: a picture's worth
+    // of per-pixel sums would be fresh memory, paid for in page faults every render.
+    let shared = std::sync::Mutex::new((film, stats));
+    let finished = order
+        .par_iter()
+        .map(|&t| {
+            if control.cancel.load(Ordering::Relaxed) {
+                return false;
+            }
+            let tile = &tiles[t as usize];
+            let Some((pixels, s)) = render_tile(scene, integrator, job, earlier, tile, control.cancel) else {
+                return false;
+            };
+            {
+                let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
+                let (film, stats) = &mut *guard;
+                stats.add(&s);
+                let tw = (tile.x1 - tile.x0) as usize;
+                for (row, chunk) in pixels.chunks(tw).enumerate() {
+                    let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
+                    for (i, p) in chunk.iter().enumerate() {
+                        film.add(start + i, &p.sum, p.taken, &p.aov);
+                        if let Some(noise) = &mut film.noise {
+                            noise[start + i] = p.noise;
+                        }
+                    }
                 }
             }
-        }
+            (control.progress)(pixels.len() as u64 * job.samples.len() as u64);
+            true
+        })
+        .reduce(|| true, |a, b| a & b);
+    if !finished {
+        return None;
     }
+    let (film, stats) = shared.into_inner().unwrap_or_else(|e| e.into_inner());
     Some((film, stats))
 }
 
