@@ -138,6 +138,12 @@ impl Scene {
         self.geometry.closest_hits(rays, out)
     }
 
+    /// [`Scene::occluded`] of each of `rays` (`out[i]` for `rays[i]`): coherent rays,
+    /// such as the shadow rays from one point toward an area light, travel together.
+    pub fn occluded_rays(&self, rays: &[Ray], out: &mut [bool]) {
+        self.geometry.occluded_rays(rays, out)
+    }
+
     pub fn surface_point(&self, hit: &Hit, ray: &Ray) -> SurfacePoint {
         self.geometry.surface_point(hit, ray.origin, ray.dir)
     }

@@ -209,8 +209,9 @@ fn same_bytes_for_any_thread_count_and_structure() {
 }
 
 #[test]
-fn camera_rays_in_packets_give_the_bytes_of_single_rays() {
-    // The BVH traces a tile's camera rays in packets (16 or 8 rays); the list traces
+fn rays_in_packets_give_the_bytes_of_single_rays() {
+    // The BVH traces a tile's camera rays, and the shadow rays from a point toward an
+    // area light (81 of them: two batches), in packets (16 or 8 rays); the list traces
     // them one by one. Triangles (tested across the rays of a packet), spheres (ray by
     // ray), a plane (outside every structure), several samples per pixel, and both
     // integrators.
@@ -227,7 +228,9 @@ fn camera_rays_in_packets_give_the_bytes_of_single_rays() {
     fs::write(dir.join("s.test"), format!("{scene}spp 4\n")).unwrap();
     let path = "spp 8\nintegrator pathtracer\nquadLight -1 3 -1 2 0 0 0 0 2 5 5 5\n";
     fs::write(dir.join("p.test"), format!("{scene}{path}")).unwrap();
-    for s in ["s", "p"] {
+    let area = "lightsamples 81\nlightstratify on\nquadLight -1 3 -1 2 0 0 0 0 2 5 5 5\n";
+    fs::write(dir.join("q.test"), format!("{scene}{area}")).unwrap();
+    for s in ["s", "p", "q"] {
         for accel in ["bvh", "list"] {
             let out = format!("{s}-{accel}.png");
             let o = lucent(

@@ -84,6 +84,12 @@ pub trait Accelerator<P: PrimitiveSet + ?Sized>: Send + Sync {
             *o = self.closest_hit(prims, &PreparedRay::new(*r));
         }
     }
+    /// [`Accelerator::occluded`] of many rays, likewise.
+    fn occluded_rays(&self, prims: &P, rays: &[Ray], out: &mut [bool]) {
+        for (o, r) in out.iter_mut().zip(rays) {
+            *o = self.occluded(prims, &PreparedRay::new(*r));
+        }
+    }
 }
 
 /// The structures `lucent render --accel` offers.

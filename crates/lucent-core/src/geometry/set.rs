@@ -66,6 +66,23 @@ impl Geometry {
         }
     }
 
+    /// [`Geometry::occluded`] of each of `rays` (`out[i]` for `rays[i]`), coherent rays
+    /// together (see [`Accelerator::occluded_rays`]).
+    pub fn occluded_rays(&self, rays: &[Ray], out: &mut [bool]) {
+        self.accel.occluded_rays(&self.primitives, rays, out);
+        if !self.unbounded.is_empty() {
+            for (blocked, ray) in out.iter_mut().zip(rays) {
+                if !*blocked {
+                    let r = PreparedRay::new(*ray);
+                    *blocked = self
+                        .unbounded
+                        .iter()
+                        .any(|&i| self.primitives[i as usize].occludes(&r, ray.t_max));
+                }
+            }
+        }
+    }
+
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let r = PreparedRay::new(*ray);

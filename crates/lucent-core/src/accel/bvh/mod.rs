@@ -316,6 +316,10 @@ impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
     fn closest_hits(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
         Bvh::closest_hits(self, prims, rays, out)
     }
+
+    fn occluded_rays(&self, prims: &P, rays: &[Ray], out: &mut [bool]) {
+        Bvh::occluded_rays(self, prims, rays, out)
+    }
 }
 
 #[cfg(test)]
