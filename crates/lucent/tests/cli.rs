@@ -213,8 +213,8 @@ fn rays_in_packets_give_the_bytes_of_single_rays() {
     // The BVH traces a tile's camera rays, and the shadow rays from a point toward an
     // area light (81 of them: two batches), in packets (16 or 8 rays); the list traces
     // them one by one. Triangles (tested across the rays of a packet), spheres (ray by
-    // ray), a plane (outside every structure), several samples per pixel, and both
-    // integrators.
+    // ray), a plane (outside every structure), several samples per pixel, the ray
+    // tracer, `direct` and the path tracer.
     let dir = workdir("packets");
     let mut scene = String::from(SCENE);
     scene += "vertex -1 -0.5 -1\nvertex 1 -0.5 -1\nvertex 0 0.5 -1.2\n";
@@ -230,7 +230,8 @@ fn rays_in_packets_give_the_bytes_of_single_rays() {
     fs::write(dir.join("p.test"), format!("{scene}{path}")).unwrap();
     let area = "lightsamples 81\nlightstratify on\nquadLight -1 3 -1 2 0 0 0 0 2 5 5 5\n";
     fs::write(dir.join("q.test"), format!("{scene}{area}")).unwrap();
-    for s in ["s", "p", "q"] {
+    fs::write(dir.join("d.test"), format!("{scene}integrator direct\n{area}")).unwrap();
+    for s in ["s", "p", "q", "d"] {
         for accel in ["bvh", "list"] {
             let out = format!("{s}-{accel}.png");
             let o = lucent(

@@ -11,10 +11,14 @@ use super::TraceCounts;
 use crate::hit::SurfacePoint;
 use crate::light::LightSample;
 use crate::math::{Color, Vec3A};
+use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::sampling::mis::power_heuristic;
 use crate::scene::Scene;
 use crate::shading::bsdf::Bsdf;
+
+/// Shadow rays from one point toward one light traced together, at most this many.
+const SHADOW_BATCH: usize = 64;
 
 /// Whether nothing blocks the segment from `x` to the light sample (a shadow ray that
 /// stops ε short of the sampled point).
@@ -54,18 +58,35 @@ pub fn every_light(
         let light = scene.sampled_light(i);
         let n = if light.is_delta() { 1 } else { samples.max(1) };
         let mut sum = Color::ZERO;
+        // The shadow rays from `x` toward one light are coherent: made a batch at a time
+        // and traced together (packets), then added in sample order, as one at a time.
+        let mut shadows = [Ray::new(Vec3A::ZERO, Vec3A::Z); SHADOW_BATCH];
+        let mut lit = [Color::ZERO; SHADOW_BATCH];
+        let mut blocked = [false; SHADOW_BATCH];
+        let mut made = 0;
         for k in 0..n {
             // Only a light made of pieces draws a number to choose one (so the numbers
             // of the course's quad-light scenes are the ones they always were).
             let pick = if light.has_pieces() { sampler.uniform() } else { 0.0 };
             let (u, v) = sampler.uniform2();
             let (u, v) = if stratify { stratified(k, n, u, v) } else { (u, v) };
-            let Some(s) = light.sample_li(x.point, pick, u, v) else {
-                continue;
-            };
-            let c = unshadowed(x, bsdf, wo, &s);
-            if c != Color::ZERO && unoccluded(scene, x, &s, counts) {
-                sum += c;
+            if let Some(s) = light.sample_li(x.point, pick, u, v) {
+                let c = unshadowed(x, bsdf, wo, &s);
+                if c != Color::ZERO {
+                    counts.rays += 1;
+                    shadows[made] = x.spawn_segment(s.wi, s.distance);
+                    lit[made] = c;
+                    made += 1;
+                }
+            }
+            if made == SHADOW_BATCH || (k + 1 == n && made > 0) {
+                scene.occluded_rays(&shadows[..made], &mut blocked[..made]);
+                for (&c, &b) in lit[..made].iter().zip(&blocked) {
+                    if !b {
+                        sum += c;
+                    }
+                }
+                made = 0;
             }
         }
         total += sum / n as f32;
