@@ -32,8 +32,11 @@ use crate::ray::{PreparedRay, Ray};
 /// measurable speed.
 #[inline(always)]
 pub fn search_limit(t: f32) -> f32 {
-    t * (1.0 + 1.0 / 4096.0)
+    t * SEARCH_SLACK
 }
+
+/// [`search_limit`]'s factor.
+pub const SEARCH_SLACK: f32 = 1.0 + 1.0 / 4096.0;
 
 /// What a structure is built over, each item known by its index: the primitives of a
 /// scene or of an instanced object, or the triangles of one mesh (both implement it on

@@ -38,6 +38,8 @@ pub trait RayLanes: Copy {
     unsafe fn eq(self, o: Self) -> u32;
     /// Lanes whose sign bit is set (NaN lanes included, whatever they mean).
     unsafe fn sign_bits(self) -> u32;
+    /// `a` in the lanes of `mask`, `b` elsewhere.
+    unsafe fn select(mask: u32, a: Self, b: Self) -> Self;
     /// Bitwise `self ^ o` and `self | o` of the lanes' bit patterns.
     unsafe fn xor(self, o: Self) -> Self;
     unsafe fn or(self, o: Self) -> Self;
@@ -126,6 +128,12 @@ mod x86 {
         #[inline(always)]
         unsafe fn sign_bits(self) -> u32 {
             _mm256_movemask_ps(self.0) as u32
+        }
+        #[inline(always)]
+        unsafe fn select(mask: u32, a: Self, b: Self) -> Self {
+            let lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let m = _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(mask as i32), lane), lane);
+            Rays8(_mm256_blendv_ps(b.0, a.0, _mm256_castsi256_ps(m)))
         }
         #[inline(always)]
         unsafe fn xor(self, o: Self) -> Self {
@@ -217,6 +225,10 @@ mod x86 {
         #[inline(always)]
         unsafe fn sign_bits(self) -> u32 {
             _mm512_cmplt_epi32_mask(bits512(self.0), _mm512_setzero_si512()) as u32
+        }
+        #[inline(always)]
+        unsafe fn select(mask: u32, a: Self, b: Self) -> Self {
+            Rays16(_mm512_mask_blend_ps(mask as __mmask16, b.0, a.0))
         }
         #[inline(always)]
         unsafe fn xor(self, o: Self) -> Self {

@@ -24,7 +24,7 @@ use super::ray_lanes::RayLanes;
 use super::ray_triangle::{self, ShearedRays};
 use super::traverse::{leaf_packets, FmaOffsets};
 use super::wide::{WideNode, EMPTY, LEAF, WIDTH};
-use crate::accel::{search_limit, PrimitiveSet};
+use crate::accel::{PrimitiveSet, SEARCH_SLACK};
 use crate::hit::Hit;
 use crate::ray::{PreparedRay, Ray};
 use std::mem::MaybeUninit;
@@ -368,11 +368,13 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
         made: 0,
         prepared: [const { MaybeUninit::uninit() }; MAX_PACKET],
     };
-    let mut limits = [0f32; MAX_PACKET];
+    // Each ray's closest hit so far (its far limit), and the limit boxes are searched to.
+    let mut t_max = [0f32; MAX_PACKET];
     for (i, s) in states.iter().enumerate() {
-        limits[i] = search_limit(Q::t_max(s));
+        t_max[i] = Q::t_max(s);
     }
-    let mut limit = L::load(limits.as_ptr());
+    let mut t_max_lanes = L::load(t_max.as_ptr());
+    let mut limit = t_max_lanes.mul(L::splat(SEARCH_SLACK));
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK_SIZE];
     // Each entry's rays' entry distances: a ray that has since found a hit nearer than
     // its entry is dropped from the entry when it is popped.
@@ -401,7 +403,17 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
         if e.reference & LEAF != 0 {
             match sheared {
                 Some(sh) if mask.count_ones() >= LANE_LEAF_RAYS => {
-                    live &= !leaf_by_lanes::<L, Q, P>(sh, states, packets, prims, &mut prepared, e.reference, mask);
+                    let done = leaf_by_lanes::<L, Q, P>(
+                        sh,
+                        states,
+                        packets,
+                        prims,
+                        &mut prepared,
+                        e.reference,
+                        mask,
+                        &mut t_max_lanes,
+                    );
+                    live &= !done;
                 }
                 _ => {
                     for i in bits(mask) {
@@ -409,15 +421,21 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                             live &= !(1 << i);
                         }
                     }
+                    if Q::SHRINKS {
+                        t_max_lanes.store(t_max.as_mut_ptr());
+                        for i in bits(mask) {
+                            t_max[i] = Q::t_max(&states[i]);
+                        }
+                        t_max_lanes = L::load(t_max.as_ptr());
+                    }
                 }
             }
             if live == 0 {
                 break;
             }
-            for i in bits(mask) {
-                limits[i] = search_limit(Q::t_max(&states[i]));
+            if Q::SHRINKS {
+                limit = t_max_lanes.mul(L::splat(SEARCH_SLACK));
             }
-            limit = L::load(limits.as_ptr());
             continue;
         }
         let node = &*nodes.as_ptr().cast::<u8>().add(e.reference as usize).cast::<WideNode>();
@@ -464,7 +482,9 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
 }
 
 /// Tests the leaf `reference` for the rays of `mask`, one triangle against all of them at
-/// a time; returns the rays that are finished (any-hit queries that found one).
+/// a time, keeping `t_max_lanes` (every ray's far limit) up to date; returns the rays
+/// that are finished (any-hit queries that found one).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     sh: &ShearedRays<L>,
@@ -474,12 +494,9 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     prepared: &mut Prepared,
     reference: u32,
     mask: u32,
+    t_max_lanes: &mut L,
 ) -> u32 {
     let mut t_max = [0f32; MAX_PACKET];
-    for i in bits(mask) {
-        t_max[i] = Q::t_max(&states[i]);
-    }
-    let mut t_max_lanes = L::load(t_max.as_ptr());
     let mut active = mask;
     let mut finished = 0;
     let (mut t, mut v, mut w, mut inv_det) = (
@@ -491,7 +508,7 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     for p in leaf_packets(reference) {
         let packet = &packets[p];
         for lane in 0..super::packet::LANES {
-            let changed = match packet.lane_kind(lane) {
+            let (changed, accepted, lane_t) = match packet.lane_kind(lane) {
                 LaneKind::Unused => break,
                 LaneKind::Other(id) => {
                     for i in bits(active) {
@@ -499,10 +516,10 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                             finished |= 1 << i;
                         }
                     }
-                    active
+                    (active, 0, *t_max_lanes)
                 }
                 LaneKind::Triangle(id) => {
-                    let h = ray_triangle::test(packet, lane, sh, t_max_lanes, active);
+                    let h = ray_triangle::test(packet, lane, sh, *t_max_lanes, active);
                     let (accept, scalar) = (h.accept, h.scalar);
                     if accept != 0 {
                         h.t.store(t.as_mut_ptr());
@@ -524,7 +541,7 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                             }
                         }
                     }
-                    accept | scalar
+                    (accept | scalar, accept, h.t)
                 }
             };
             if changed != 0 {
@@ -532,10 +549,20 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                 if active == 0 {
                     return finished;
                 }
-                for i in bits(changed) {
-                    t_max[i] = Q::t_max(&states[i]);
+                if Q::SHRINKS {
+                    // A closest-hit query's limit becomes the distance of every hit the
+                    // lane test accepted (a tie it keeps the old hit for is that same
+                    // distance); lanes the scalar code decided are read back.
+                    *t_max_lanes = L::select(accepted, lane_t, *t_max_lanes);
+                    let read = changed & !accepted;
+                    if read != 0 {
+                        t_max_lanes.store(t_max.as_mut_ptr());
+                        for i in bits(read) {
+                            t_max[i] = Q::t_max(&states[i]);
+                        }
+                        *t_max_lanes = L::load(t_max.as_ptr());
+                    }
                 }
-                t_max_lanes = L::load(t_max.as_ptr());
             }
         }
     }
