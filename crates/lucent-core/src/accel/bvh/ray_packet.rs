@@ -13,11 +13,11 @@
 //! the exact slab test enters: the planes are chosen by the direction's signs when the
 //! whole packet shares them, else both are computed and the `min`/`max` taken (the
 //! bound holds for both). So every ray visits at least the boxes that hold its closest
-//! hit, against its own closest hit so far and search limit. Both leaf tests compute the scalar triangle test's bits, accept
-//! `t ≤ t_max` and keep ties by primitive index, so neither the order of visits nor the
-//! order of triangles within a leaf can change a ray's answer. Rays without the fused
-//! test's constants (an axis they do not move along, a constant that is not finite) are
-//! traced alone.
+//! hit, against its own closest hit so far and search limit. Both leaf tests compute the
+//! scalar triangle test's bits, accept `t ≤ t_max` and keep ties by primitive index, so
+//! neither the order of visits nor the order of triangles within a leaf can change a
+//! ray's answer. Rays without the fused test's constants (an axis they do not move along,
+//! a constant that is not finite, a negative `t_min`) are traced alone.
 
 use super::packet::{LaneKind, Packet};
 use super::ray_lanes::RayLanes;
@@ -439,8 +439,9 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             continue;
         }
         let node = &*nodes.as_ptr().cast::<u8>().add(e.reference as usize).cast::<WideNode>();
-        // The children some active ray enters, keyed by the entry distance of the
-        // lowest such ray, pushed farthest first.
+        // The children some active ray enters; for closest-hit queries keyed by the entry
+        // distance of the lowest such ray and ordered so that the nearest is popped first
+        // (any-hit queries pop the last slot first, as single rays do).
         let base = sp;
         for c in 0..WIDTH {
             let child = node.child[c];
