@@ -33,17 +33,7 @@ impl Geometry {
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
         let r = PreparedRay::new(*ray);
         let mut best = self.accel.closest_hit(&self.primitives, &r);
-        if !self.unbounded.is_empty() {
-            for &i in &self.unbounded {
-                let t_max = best.map_or(ray.t_max, |b| b.t);
-                if let Some(hit) = self.primitives[i as usize].intersect(i, &r, t_max) {
-                    // The same tie rule as inside the structures: scene order.
-                    if Hit::is_closer_than(hit.t, i, &best) {
-                        best = Some(hit);
-                    }
-                }
-            }
-        }
+        self.nearer_unbounded(&r, &mut best);
         best
     }
 
@@ -53,17 +43,31 @@ impl Geometry {
         self.accel.closest_hits(&self.primitives, rays, out);
         if !self.unbounded.is_empty() {
             for (best, ray) in out.iter_mut().zip(rays) {
-                let r = PreparedRay::new(*ray);
-                for &i in &self.unbounded {
-                    let t_max = best.map_or(ray.t_max, |b| b.t);
-                    if let Some(hit) = self.primitives[i as usize].intersect(i, &r, t_max) {
-                        if Hit::is_closer_than(hit.t, i, best) {
-                            *best = Some(hit);
-                        }
-                    }
+                self.nearer_unbounded(&PreparedRay::new(*ray), best);
+            }
+        }
+    }
+
+    /// Replaces `best` (the structure's answer for `r`) by a nearer hit on a primitive
+    /// outside the structure (planes), with the structures' tie rule: scene order.
+    #[inline]
+    fn nearer_unbounded(&self, r: &PreparedRay, best: &mut Option<Hit>) {
+        for &i in &self.unbounded {
+            let t_max = best.map_or(r.ray.t_max, |b| b.t);
+            if let Some(hit) = self.primitives[i as usize].intersect(i, r, t_max) {
+                if Hit::is_closer_than(hit.t, i, best) {
+                    *best = Some(hit);
                 }
             }
         }
+    }
+
+    /// Whether a primitive outside the structure (a plane) blocks `r`.
+    #[inline]
+    fn unbounded_occludes(&self, r: &PreparedRay) -> bool {
+        self.unbounded
+            .iter()
+            .any(|&i| self.primitives[i as usize].occludes(r, r.ray.t_max))
     }
 
     /// [`Geometry::occluded`] of each of `rays` (`out[i]` for `rays[i]`), coherent rays
@@ -72,13 +76,7 @@ impl Geometry {
         self.accel.occluded_rays(&self.primitives, rays, out);
         if !self.unbounded.is_empty() {
             for (blocked, ray) in out.iter_mut().zip(rays) {
-                if !*blocked {
-                    let r = PreparedRay::new(*ray);
-                    *blocked = self
-                        .unbounded
-                        .iter()
-                        .any(|&i| self.primitives[i as usize].occludes(&r, ray.t_max));
-                }
+                *blocked = *blocked || self.unbounded_occludes(&PreparedRay::new(*ray));
             }
         }
     }
@@ -86,10 +84,7 @@ impl Geometry {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         let r = PreparedRay::new(*ray);
-        self.unbounded
-            .iter()
-            .any(|&i| self.primitives[i as usize].occludes(&r, ray.t_max))
-            || self.accel.occluded(&self.primitives, &r)
+        self.unbounded_occludes(&r) || self.accel.occluded(&self.primitives, &r)
     }
 
     /// World-space `∂p/∂u`, `∂p/∂v` at `hit` (see [`Primitive::tangents`]).

@@ -7,18 +7,15 @@
 //! "Every light" is every light of [`Scene::sampled_light`]: the scene's listed lights,
 //! all emissive surfaces as one light and the environment (EXTENSIONS.md).
 
+use super::shadow_batch::ShadowBatch;
 use super::TraceCounts;
 use crate::hit::SurfacePoint;
 use crate::light::LightSample;
 use crate::math::{Color, Vec3A};
-use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::sampling::mis::power_heuristic;
 use crate::scene::Scene;
 use crate::shading::bsdf::Bsdf;
-
-/// Shadow rays from one point toward one light traced together, at most this many.
-const SHADOW_BATCH: usize = 64;
 
 /// Whether nothing blocks the segment from `x` to the light sample (a shadow ray that
 /// stops ε short of the sampled point).
@@ -57,13 +54,7 @@ pub fn every_light(
     for i in 0..scene.sampled_light_count() {
         let light = scene.sampled_light(i);
         let n = if light.is_delta() { 1 } else { samples.max(1) };
-        let mut sum = Color::ZERO;
-        // The shadow rays from `x` toward one light are coherent: made a batch at a time
-        // and traced together (packets), then added in sample order, as one at a time.
-        let mut shadows = [Ray::new(Vec3A::ZERO, Vec3A::Z); SHADOW_BATCH];
-        let mut lit = [Color::ZERO; SHADOW_BATCH];
-        let mut blocked = [false; SHADOW_BATCH];
-        let mut made = 0;
+        let mut shadows = ShadowBatch::new();
         for k in 0..n {
             // Only a light made of pieces draws a number to choose one (so the numbers
             // of the course's quad-light scenes are the ones they always were).
@@ -73,23 +64,11 @@ pub fn every_light(
             if let Some(s) = light.sample_li(x.point, pick, u, v) {
                 let c = unshadowed(x, bsdf, wo, &s);
                 if c != Color::ZERO {
-                    counts.rays += 1;
-                    shadows[made] = x.spawn_segment(s.wi, s.distance);
-                    lit[made] = c;
-                    made += 1;
+                    shadows.add(scene, x.spawn_segment(s.wi, s.distance), c, counts);
                 }
-            }
-            if made == SHADOW_BATCH || (k + 1 == n && made > 0) {
-                scene.occluded_rays(&shadows[..made], &mut blocked[..made]);
-                for (&c, &b) in lit[..made].iter().zip(&blocked) {
-                    if !b {
-                        sum += c;
-                    }
-                }
-                made = 0;
             }
         }
-        total += sum / n as f32;
+        total += shadows.sum(scene) / n as f32;
     }
     total
 }

@@ -1,13 +1,15 @@
 //! Integrators: how the colour seen along a camera ray is computed. One file each —
 //! [`whitted`] (`raytracer`), [`analytic_direct`], [`direct`], [`path`] (`pathtracer`) —
-//! and [`light_sampling`], the direct-lighting estimators the last two share. The render
-//! loop only knows this trait.
+//! and [`light_sampling`], the direct-lighting estimators the last two share, with
+//! [`shadow_batch`], the shadow rays toward one light traced together. The render loop
+//! only knows this trait.
 
 pub mod analytic_direct;
 pub mod depth;
 pub mod direct;
 pub mod light_sampling;
 pub mod path;
+pub mod shadow_batch;
 pub mod whitted;
 
 use crate::hit::{Hit, SurfacePoint};

@@ -36,6 +36,7 @@
 //! can no longer show is not traced (adaptive depth control, [`super::depth`]).
 
 use super::depth::DepthControl;
+use super::shadow_batch::ShadowBatch;
 use super::{CameraHit, Integrator, TraceCounts};
 use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::light::Light;
@@ -66,9 +67,6 @@ struct Tracing<'a> {
 /// only trees deeper than 32,768 bounces get here — where mirrors or glass reflect
 /// everything (no adaptive depth control) and `maxdepth` is larger than that.
 pub const MAX_PENDING: usize = 1 << 16;
-
-/// Shadow rays toward one area light from one point traced together, at most this many.
-const SHADOW_BATCH: usize = 64;
 
 /// A branch of the ray tree waiting to be traced. The tree is walked depth first with an
 /// explicit stack — never by recursion, whose depth the scene would control — in the
@@ -121,14 +119,7 @@ impl Whitted {
         for light in &scene.lights {
             if let Light::Quad(q) = light {
                 let count = self.light_samples.max(1);
-                let mut sum = Color::ZERO;
-                // The shadow rays from this point toward the light are coherent: they are
-                // made a batch at a time and traced together (packets), then added in
-                // sample order, as one at a time would.
-                let mut shadows = [Ray::new(Vec3A::ZERO, Vec3A::Z); SHADOW_BATCH];
-                let mut lit = [Color::ZERO; SHADOW_BATCH];
-                let mut blocked = [false; SHADOW_BATCH];
-                let mut made = 0;
+                let mut shadows = ShadowBatch::new();
                 for k in 0..count {
                     let (u, v) = t.sampler.uniform2();
                     let (u, v) = if self.light_stratify {
@@ -140,23 +131,12 @@ impl Whitted {
                     let reflected = diffuse * n.dot(inc.dir).max(0.0)
                         + m.specular * n.dot((inc.dir + view).normalize()).max(0.0).powf(m.shininess);
                     if reflected != Color::ZERO && inc.intensity != Color::ZERO {
-                        t.counts.rays += 1;
                         // Aimed at a point on the light: stops just before it.
-                        shadows[made] = sp.spawn_segment(inc.dir, inc.distance);
-                        lit[made] = inc.intensity * reflected;
-                        made += 1;
-                    }
-                    if made == SHADOW_BATCH || (k + 1 == count && made > 0) {
-                        scene.occluded_rays(&shadows[..made], &mut blocked[..made]);
-                        for (&l, &b) in lit[..made].iter().zip(&blocked) {
-                            if !b {
-                                sum += l;
-                            }
-                        }
-                        made = 0;
+                        let shadow = sp.spawn_segment(inc.dir, inc.distance);
+                        shadows.add(scene, shadow, inc.intensity * reflected, t.counts);
                     }
                 }
-                color += sum / count as f32;
+                color += shadows.sum(scene) / count as f32;
                 continue;
             }
             let inc = light.incidence(sp.point);

@@ -172,7 +172,7 @@ impl Bvh {
                         ray_packet::traverse_avx2::<Q, P>(nodes, packets, prims, chunk, states)
                     }
                 };
-                for i in ray_packet::bits(alone) {
+                for i in packet::Lanes(alone) {
                     states[i] = single(&chunk[i]);
                 }
                 for (i, s) in states.iter().enumerate() {

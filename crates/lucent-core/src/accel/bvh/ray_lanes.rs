@@ -53,6 +53,18 @@ mod x86 {
     use super::RayLanes;
     use std::arch::x86_64::*;
 
+    /// The lane-wise arithmetic, each the one intrinsic it names.
+    macro_rules! binary_ops {
+        ($t:ident: $($op:ident $f:ident),+) => {
+            $(
+                #[inline(always)]
+                unsafe fn $op(self, o: Self) -> Self {
+                    $t($f(self.0, o.0))
+                }
+            )+
+        };
+    }
+
     /// Eight rays (AVX2).
     #[derive(Clone, Copy)]
     pub struct Rays8(__m256);
@@ -85,33 +97,10 @@ mod x86 {
         unsafe fn abs(self) -> Self {
             Rays8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0))
         }
-        #[inline(always)]
-        unsafe fn add(self, o: Self) -> Self {
-            Rays8(_mm256_add_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn sub(self, o: Self) -> Self {
-            Rays8(_mm256_sub_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn mul(self, o: Self) -> Self {
-            Rays8(_mm256_mul_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn div(self, o: Self) -> Self {
-            Rays8(_mm256_div_ps(self.0, o.0))
-        }
+        binary_ops!(Rays8: add _mm256_add_ps, sub _mm256_sub_ps, mul _mm256_mul_ps, div _mm256_div_ps, min _mm256_min_ps, max _mm256_max_ps);
         #[inline(always)]
         unsafe fn mul_sub(self, b: Self, c: Self) -> Self {
             Rays8(_mm256_fmsub_ps(self.0, b.0, c.0))
-        }
-        #[inline(always)]
-        unsafe fn min(self, o: Self) -> Self {
-            Rays8(_mm256_min_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn max(self, o: Self) -> Self {
-            Rays8(_mm256_max_ps(self.0, o.0))
         }
         #[inline(always)]
         unsafe fn le(self, o: Self) -> u32 {
@@ -182,33 +171,10 @@ mod x86 {
         unsafe fn abs(self) -> Self {
             Rays16(_mm512_abs_ps(self.0))
         }
-        #[inline(always)]
-        unsafe fn add(self, o: Self) -> Self {
-            Rays16(_mm512_add_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn sub(self, o: Self) -> Self {
-            Rays16(_mm512_sub_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn mul(self, o: Self) -> Self {
-            Rays16(_mm512_mul_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn div(self, o: Self) -> Self {
-            Rays16(_mm512_div_ps(self.0, o.0))
-        }
+        binary_ops!(Rays16: add _mm512_add_ps, sub _mm512_sub_ps, mul _mm512_mul_ps, div _mm512_div_ps, min _mm512_min_ps, max _mm512_max_ps);
         #[inline(always)]
         unsafe fn mul_sub(self, b: Self, c: Self) -> Self {
             Rays16(_mm512_fmsub_ps(self.0, b.0, c.0))
-        }
-        #[inline(always)]
-        unsafe fn min(self, o: Self) -> Self {
-            Rays16(_mm512_min_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn max(self, o: Self) -> Self {
-            Rays16(_mm512_max_ps(self.0, o.0))
         }
         #[inline(always)]
         unsafe fn le(self, o: Self) -> u32 {

@@ -19,7 +19,7 @@
 //! ray's answer. Rays without the fused test's constants (an axis they do not move along,
 //! a constant that is not finite, a negative `t_min`) are traced alone.
 
-use super::packet::{LaneKind, Packet};
+use super::packet::{LaneKind, Lanes as Bits, Packet};
 use super::ray_lanes::RayLanes;
 use super::ray_triangle::{self, ShearedRays};
 use super::traverse::{leaf_packets, FmaOffsets};
@@ -268,18 +268,6 @@ impl PacketQuery for AnyQuery {
     }
 }
 
-/// The set bits of a mask, lowest first.
-#[inline(always)]
-pub(super) fn bits(mut m: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (m != 0).then(|| {
-            let i = m.trailing_zeros() as usize;
-            m &= m - 1;
-            i
-        })
-    })
-}
-
 /// A stack entry: a node (or leaf) reference, the rays that entered it, and the entry
 /// distance of the lowest of them (for the order of visits only).
 #[derive(Clone, Copy)]
@@ -416,14 +404,14 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                     live &= !done;
                 }
                 _ => {
-                    for i in bits(mask) {
+                    for i in Bits(mask) {
                         if Q::leaf(&mut states[i], packets, prims, prepared.get(i), e.reference) {
                             live &= !(1 << i);
                         }
                     }
                     if Q::SHRINKS {
                         t_max_lanes.store(t_max.as_mut_ptr());
-                        for i in bits(mask) {
+                        for i in Bits(mask) {
                             t_max[i] = Q::t_max(&states[i]);
                         }
                         t_max_lanes = L::load(t_max.as_ptr());
@@ -512,7 +500,7 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             let (changed, accepted, lane_t) = match packet.lane_kind(lane) {
                 LaneKind::Unused => break,
                 LaneKind::Other(id) => {
-                    for i in bits(active) {
+                    for i in Bits(active) {
                         if Q::other(&mut states[i], prims, prepared.get(i), id) {
                             finished |= 1 << i;
                         }
@@ -527,14 +515,14 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                         h.v.store(v.as_mut_ptr());
                         h.w.store(w.as_mut_ptr());
                         h.inv_det.store(inv_det.as_mut_ptr());
-                        for i in bits(accept) {
+                        for i in Bits(accept) {
                             let hit = Hit::new(t[i], id, v[i] * inv_det[i], w[i] * inv_det[i]);
                             if Q::record(&mut states[i], hit) {
                                 finished |= 1 << i;
                             }
                         }
                     }
-                    for i in bits(scalar) {
+                    for i in Bits(scalar) {
                         let limit = Q::t_max(&states[i]);
                         if let Some((t, b1, b2)) = packet.scalar_triangle(prepared.get(i), lane, limit) {
                             if Q::record(&mut states[i], Hit::new(t, id, b1, b2)) {
@@ -558,7 +546,7 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                     let read = changed & !accepted;
                     if read != 0 {
                         t_max_lanes.store(t_max.as_mut_ptr());
-                        for i in bits(read) {
+                        for i in Bits(read) {
                             t_max[i] = Q::t_max(&states[i]);
                         }
                         *t_max_lanes = L::load(t_max.as_ptr());
