@@ -5,9 +5,10 @@
 //! once, the 15 candidate planes per axis are priced with
 //! `C_trav + (A_l·P(N_l) + A_r·P(N_r)) / A`, where `P(n) = ⌈n/4⌉` counts the four-wide
 //! packets a leaf of `n` primitives needs, and the node becomes a leaf when that is no
-//! cheaper than its own packets. Below depth 48 (only pathological inputs get there), and
-//! when no plane separates the centroids, nodes are split at the object median so the
-//! depth stays bounded. The build works on a flat array of 32-byte references that it
+//! cheaper than its own packets. (Only the planes between occupied bins are priced, and a
+//! node of one packet is a leaf without binning: the same choices, for less.) Below
+//! depth 48 (only pathological inputs get there), and when no plane separates the
+//! centroids, nodes are split at the object median so the depth stays bounded. The build works on a flat array of 32-byte references that it
 //! partitions in place: no allocation per node and no indirection.
 //!
 //! Subtrees of more than [`PARALLEL_REFS`] references are built on two threads at once
@@ -58,11 +59,17 @@ impl BuildRef {
     }
     #[inline(always)]
     fn lo(&self) -> Vec3A {
-        Vec3A::from_array(self.lo)
+        load_xyz::<0>(self)
     }
     #[inline(always)]
     fn hi(&self) -> Vec3A {
-        Vec3A::from_array(self.hi)
+        load_xyz::<1>(self)
+    }
+    pub fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.lo(),
+            max: self.hi(),
+        }
     }
     /// Twice the centroid (the factor ½ cancels in every use).
     #[inline(always)]
@@ -70,6 +77,31 @@ impl BuildRef {
         self.lo() + self.hi()
     }
 }
+
+/// Half `HALF` of a reference (0: `lo` and `prim`, 1: `hi` and `bins`) as a vector of
+/// its three floats: one aligned load on x86-64, the fourth lane cleared (the builder
+/// reads references some hundred million times; assembling three scalars costs more).
+#[inline(always)]
+fn load_xyz<const HALF: usize>(r: &BuildRef) -> Vec3A {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a `BuildRef` is 32 bytes, 32-byte aligned, with `lo` at offset 0 and `hi`
+    // at 16 (asserted below): both halves are aligned, readable 16-byte groups; the
+    // fourth float of each (`prim` or `bins`) is masked off.
+    unsafe {
+        use std::arch::x86_64::*;
+        let xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
+        let half = (r as *const BuildRef as *const f32).add(4 * HALF);
+        Vec3A::from(_mm_and_ps(_mm_load_ps(half), xyz))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    Vec3A::from_array(if HALF == 0 { r.lo } else { r.hi })
+}
+
+const _: () = assert!(
+    std::mem::offset_of!(BuildRef, lo) == 0
+        && std::mem::offset_of!(BuildRef, hi) == 16
+        && std::mem::size_of::<BuildRef>() == 32
+);
 
 #[derive(Clone, Copy, Debug)]
 pub enum Kind {
@@ -294,20 +326,47 @@ type Bins = [[Bin; BINS]; 3];
 /// Sorts the references' centroids into bins along the three axes (and notes each
 /// one's bins in it).
 fn bin_refs(refs: &mut [BuildRef], lo: Vec3A, scale: Vec3A) -> Bins {
-    let mut bins = [[EMPTY_BIN; BINS]; 3];
-    let max_bin = Vec3A::splat((BINS - 1) as f32);
-    for r in refs.iter_mut() {
-        let b = bin_indices(((r.centroid2() - lo) * scale).min(max_bin)).map(|i| i as usize & (BINS - 1));
-        r.bins = (b[0] | b[1] << 4 | b[2] << 8) as u32;
-        let (rlo, rhi) = (r.lo(), r.hi());
-        for (axis, bin_axis) in bins.iter_mut().enumerate() {
-            let bin = &mut bin_axis[b[axis]];
-            bin.lo = bin.lo.min(rlo);
-            bin.hi = bin.hi.max(rhi);
-            bin.count += 1;
+    if refs.len() < TWO_BIN_SETS {
+        let mut bins = [[EMPTY_BIN; BINS]; 3];
+        for r in refs.iter_mut() {
+            bin_ref(&mut bins, r, lo, scale);
         }
+        return bins;
     }
-    bins
+    // Neighbouring references mostly fall into the same bins, and each bin update waits
+    // for the one before it (load, min, store): alternating between two sets of bins
+    // halves that chain. Merging them is exact (minima, maxima, counts).
+    let (mut even, mut odd) = ([[EMPTY_BIN; BINS]; 3], [[EMPTY_BIN; BINS]; 3]);
+    let mut pairs = refs.chunks_exact_mut(2);
+    for pair in &mut pairs {
+        let [a, b] = pair else { unreachable!("pairs") };
+        bin_ref(&mut even, a, lo, scale);
+        bin_ref(&mut odd, b, lo, scale);
+    }
+    for r in pairs.into_remainder() {
+        bin_ref(&mut even, r, lo, scale);
+    }
+    merge_bins(even, odd)
+}
+
+/// Nodes over at least this many references bin them into two sets of bins.
+const TWO_BIN_SETS: usize = 64;
+
+/// Adds one reference to `bins` and notes its bins in it.
+#[inline(always)]
+fn bin_ref(bins: &mut Bins, r: &mut BuildRef, lo: Vec3A, scale: Vec3A) {
+    let max_bin = Vec3A::splat((BINS - 1) as f32);
+    // Both halves are read once, before `bins` is written (a 16-byte load of the half
+    // that holds a 4-byte store still in flight waits for it).
+    let (rlo, rhi) = (r.lo(), r.hi());
+    let b = bin_indices(((rlo + rhi - lo) * scale).min(max_bin)).map(|i| i as usize & (BINS - 1));
+    for (axis, bin_axis) in bins.iter_mut().enumerate() {
+        let bin = &mut bin_axis[b[axis]];
+        bin.lo = bin.lo.min(rlo);
+        bin.hi = bin.hi.max(rhi);
+        bin.count += 1;
+    }
+    r.bins = (b[0] | b[1] << 4 | b[2] << 8) as u32;
 }
 
 /// The bins of two groups of references together.
@@ -326,6 +385,12 @@ fn merge_bins(mut a: Bins, b: Bins) -> Bins {
 /// plane separates the centroids).
 fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
     let count = refs.len();
+    // A split costs at least the traversal step, no less than one packet: a node that
+    // fits in one packet is a leaf, whatever its planes would cost (most nodes are
+    // these, so they are not binned for nothing).
+    if count <= MAX_LEAF && TRAVERSAL_COST >= packets(count) {
+        return None;
+    }
     let extent = cb.max - cb.min;
     let lo = cb.min;
     // Axes with no extent get scale 0: everything lands in bin 0 and no plane is priced.
@@ -342,33 +407,7 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
     } else {
         bin_refs(refs, lo, scale)
     };
-    let mut best: Option<(f32, usize, usize)> = None; // (cost, axis, first bin on the right)
-    for axis in 0..3 {
-        if scale[axis] == 0.0 {
-            continue;
-        }
-        let bins = &bins[axis];
-        let mut right_cost = [0.0f32; BINS];
-        let (mut rlo, mut rhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
-        for k in (1..BINS).rev() {
-            rlo = rlo.min(bins[k].lo);
-            rhi = rhi.max(bins[k].hi);
-            n += bins[k].count as usize;
-            right_cost[k] = if n == 0 { f32::NAN } else { area(rlo, rhi) * packets(n) };
-        }
-        let (mut llo, mut lhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
-        for k in 1..BINS {
-            llo = llo.min(bins[k - 1].lo);
-            lhi = lhi.max(bins[k - 1].hi);
-            n += bins[k - 1].count as usize;
-            let cost = area(llo, lhi) * packets(n) + right_cost[k];
-            // An empty side (NaN cost) is no split.
-            if n > 0 && !cost.is_nan() && best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, k));
-            }
-        }
-    }
-    let (cost, axis, split_bin) = best?;
+    let (cost, axis, split_bin) = cheapest_plane(&bins, scale)?;
     let a = area(bounds.min, bounds.max);
     let split_cost = TRAVERSAL_COST + if a > 0.0 { cost / a } else { packets(count) };
     if count <= MAX_LEAF && split_cost >= packets(count) {
@@ -401,6 +440,60 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
         left: (union(&bins[..split_bin]), centroids[0]),
         right: (union(&bins[split_bin..]), centroids[1]),
     })
+}
+
+/// No plane chosen (see [`cheapest_plane`]).
+const NO_PLANE: u32 = u32::MAX;
+
+/// The cheapest plane of `bins` by the SAH, as (cost, axis, first bin on the right);
+/// `None` when no plane has references on both sides. Axes of `scale` 0 are not split.
+fn cheapest_plane(bins: &Bins, scale: Vec3A) -> Option<(f32, usize, usize)> {
+    // The cheapest plane so far, as its cost and `axis << 8 | first bin on the right`
+    // (none yet: cost ∞), chosen without branches: which candidate wins is data, and a
+    // mispredicted branch per win cost more than the pricing.
+    let (mut best_cost, mut best_plane) = (f32::INFINITY, NO_PLANE);
+    for axis in 0..3 {
+        if scale[axis] == 0.0 {
+            continue;
+        }
+        let bins = &bins[axis];
+        // Only planes between two occupied bins can split, and all planes in one gap
+        // between them make the same two sides at the same cost: pricing the lowest plane
+        // of each gap, in order, finds the split that pricing every plane finds (its
+        // folds skip only empty bins, which change no bit), at the cost of the occupied
+        // bins alone — few in the many small nodes near the leaves.
+        let mut occupied = [0u8; BINS];
+        let mut m = 0;
+        for (k, bin) in bins.iter().enumerate() {
+            occupied[m] = k as u8;
+            m += (bin.count > 0) as usize;
+        }
+        let occupied = &occupied[..m];
+        // right_cost[t]: the bins occupied[t..] on the right.
+        let mut right_cost = [0.0f32; BINS];
+        let (mut rlo, mut rhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
+        for t in (1..m).rev() {
+            let bin = &bins[occupied[t] as usize];
+            rlo = rlo.min(bin.lo);
+            rhi = rhi.max(bin.hi);
+            n += bin.count as usize;
+            right_cost[t] = area(rlo, rhi) * packets(n);
+        }
+        let (mut llo, mut lhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
+        for t in 1..m {
+            let bin = &bins[occupied[t - 1] as usize];
+            llo = llo.min(bin.lo);
+            lhi = lhi.max(bin.hi);
+            n += bin.count as usize;
+            let cost = area(llo, lhi) * packets(n) + right_cost[t];
+            // (A NaN or infinite cost, from areas past f32's range, never wins.)
+            let better = cost < best_cost;
+            best_cost = if better { cost } else { best_cost };
+            let plane = (axis as u32) << 8 | (occupied[t - 1] as u32 + 1);
+            best_plane = if better { plane } else { best_plane };
+        }
+    }
+    (best_plane != NO_PLANE).then_some((best_cost, (best_plane >> 8) as usize, (best_plane & 0xff) as usize))
 }
 
 /// In-place partition (Hoare style): how many elements satisfy `pred` (they come first),
@@ -455,7 +548,7 @@ fn median_split(refs: &mut [BuildRef], cb: &Aabb) -> Split {
 }
 
 #[cfg(test)]
-mod parallel_tests {
+mod tests {
     use super::*;
 
     fn boxes(n: u32) -> Vec<(u32, Aabb)> {
@@ -481,6 +574,82 @@ mod parallel_tests {
             t.nodes.iter().map(|n| format!("{n:?}")).collect(),
             t.refs.iter().map(|r| r.prim).collect(),
         )
+    }
+
+    /// Every one of the 15 planes per axis priced, empty bins folded in (the plain
+    /// binned SAH), the first cheapest one kept.
+    fn cheapest_of_every_plane(bins: &Bins, scale: Vec3A) -> Option<(f32, usize, usize)> {
+        let mut best: Option<(f32, usize, usize)> = None;
+        for axis in (0..3).filter(|&a| scale[a] != 0.0) {
+            let bins = &bins[axis];
+            for k in 1..BINS {
+                let side = |range: &[Bin]| {
+                    range
+                        .iter()
+                        .fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize), |(lo, hi, n), b| {
+                            (lo.min(b.lo), hi.max(b.hi), n + b.count as usize)
+                        })
+                };
+                let (llo, lhi, nl) = side(&bins[..k]);
+                let (rlo, rhi, nr) = side(&bins[k..]);
+                let cost = area(llo, lhi) * packets(nl) + area(rlo, rhi) * packets(nr);
+                if nl > 0 && nr > 0 && best.is_none_or(|(c, _, _)| cost < c) {
+                    best = Some((cost, axis, k));
+                }
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn pricing_only_occupied_gaps_finds_the_plane_every_plane_finds() {
+        for n in [2, 3, 5, 8, 13, 17, 40, 100, 300] {
+            for seed in 0..20 {
+                // Boxes clustered on a few spots, so many bins stay empty and many
+                // planes tie.
+                let mut refs: Vec<BuildRef> = boxes(n + seed * 7)
+                    .into_iter()
+                    .skip(seed as usize * 7)
+                    .map(|(i, b)| {
+                        let snapped = Aabb {
+                            min: (b.min / 25.0).round() * 25.0,
+                            max: (b.min / 25.0).round() * 25.0 + (b.max - b.min),
+                        };
+                        BuildRef::new(if seed % 2 == 0 { &snapped } else { &b }, i)
+                    })
+                    .collect();
+                let (_, cb) = range_bounds(&refs);
+                let extent = cb.max - cb.min;
+                let scale = Vec3A::select(
+                    extent.cmpgt(Vec3A::ZERO),
+                    Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / extent,
+                    Vec3A::ZERO,
+                );
+                let bins = bin_refs(&mut refs, cb.min, scale);
+                let fast = cheapest_plane(&bins, scale).map(|(c, a, k)| (c.to_bits(), a, k));
+                let every = cheapest_of_every_plane(&bins, scale).map(|(c, a, k)| (c.to_bits(), a, k));
+                assert_eq!(fast, every, "{n} boxes, seed {seed}");
+            }
+        }
+    }
+
+    #[test]
+    fn two_sets_of_bins_bin_as_one() {
+        let mut refs: Vec<BuildRef> = boxes(1000).iter().map(|(i, b)| BuildRef::new(b, *i)).collect();
+        let (_, cb) = range_bounds(&refs);
+        let scale = Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / (cb.max - cb.min);
+        let mut one = [[EMPTY_BIN; BINS]; 3];
+        for r in refs.iter_mut() {
+            bin_ref(&mut one, r, cb.min, scale);
+        }
+        let two = bin_refs(&mut refs, cb.min, scale);
+        assert!(refs.len() >= TWO_BIN_SETS);
+        for (a, b) in one.iter().flatten().zip(two.iter().flatten()) {
+            assert_eq!(
+                (a.lo.to_array(), a.hi.to_array(), a.count),
+                (b.lo.to_array(), b.hi.to_array(), b.count)
+            );
+        }
     }
 
     #[test]

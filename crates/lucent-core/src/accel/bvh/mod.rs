@@ -100,16 +100,16 @@ impl Bvh {
     /// Builds for a given instruction set (tests use this to check every path).
     pub fn build_for<P: PrimitiveSet + ?Sized>(prims: &P, isa: Isa) -> Bvh {
         // The references in primitive order, their boxes computed on the pool's threads.
-        let refs: Vec<binary::BuildRef> = {
+        let mut refs: Vec<binary::BuildRef> = {
             use rayon::prelude::*;
+            // Indexed, so the references are written in place (a filtered parallel
+            // iterator would gather chunks and copy them once more).
             (0..prims.count() as u32)
                 .into_par_iter()
-                .filter_map(|i| {
-                    let b = prims.bounds(i);
-                    super::is_bounded(&b).then(|| binary::BuildRef::new(&b, i))
-                })
+                .map(|i| binary::BuildRef::new(&prims.bounds(i), i))
                 .collect()
         };
+        refs.retain(|r| super::is_bounded(&r.bounds()));
         let tree = binary::build_refs(refs);
         let wide = wide::collapse(&tree, prims);
         assert!(Isa::available().contains(&isa), "{isa:?} requested on a CPU without it");

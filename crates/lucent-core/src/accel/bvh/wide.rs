@@ -6,7 +6,8 @@
 //! becomes one leaf (of at most two packets) instead of a node. The node stores its
 //! children's boxes as structure-of-arrays, so one AVX instruction (or two SSE ones)
 //! tests all eight. Leaves become runs of four-wide packets, laid out in the order
-//! traversal meets them.
+//! traversal meets them; the nodes are laid out on one thread, then the packets are
+//! filled on the pool's threads.
 
 use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
 use super::packet::{Packet, LANES};
@@ -52,24 +53,51 @@ pub struct WideTree {
 }
 
 pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
-    let mut out = WideTree {
+    let mut out = Collapse {
         nodes: Vec::with_capacity(tree.nodes.len() / 4 + 1),
-        packets: Vec::with_capacity(prims.count() / 3 + 1),
+        packet_refs: Vec::with_capacity(prims.count() / 3 + 1),
     };
     if let Some(root) = tree.nodes.first() {
         match root.kind {
             // A lone leaf still gets a node above it: traversal starts at a node.
             Kind::Leaf { .. } => {
                 out.nodes.push(WideNode::EMPTY);
-                let slot = leaf_slot(tree, root, prims, &mut out);
+                let slot = leaf_slot(root, &mut out);
                 set_child(&mut out.nodes[0], 0, root, slot);
             }
             Kind::Interior { .. } => {
-                collapse_node(tree, 0, prims, &mut out);
+                collapse_node(tree, 0, &mut out);
             }
         }
     }
-    out
+    // The packets' corners are gathered from the primitives (scattered reads, most of
+    // the collapse's time) on the pool's threads, each written in its place: the same
+    // packets for any number of threads.
+    let packets = {
+        use rayon::prelude::*;
+        out.packet_refs
+            .par_iter()
+            .map(|&(start, count)| {
+                let mut ids = [0u32; LANES];
+                let chunk = &tree.refs[start as usize..(start + count) as usize];
+                for (id, r) in ids.iter_mut().zip(chunk) {
+                    *id = r.prim;
+                }
+                Packet::new(prims, &ids[..chunk.len()])
+            })
+            .collect()
+    };
+    WideTree {
+        nodes: out.nodes,
+        packets,
+    }
+}
+
+/// The wide tree as the collapse lays it out: its nodes, and for each packet the
+/// references it will hold (`tree.refs[start..start + count]`).
+struct Collapse {
+    nodes: Vec<WideNode>,
+    packet_refs: Vec<(u32, u32)>,
 }
 
 fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u32) {
@@ -101,20 +129,16 @@ fn small_subtree(tree: &BinaryTree, n: u32) -> Option<(u32, u32)> {
     }
 }
 
-/// Emits the packets of a binary leaf; returns its slot reference.
-fn leaf_slot<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, leaf: &BinaryNode, prims: &P, out: &mut WideTree) -> u32 {
+/// Lays out the packets of a binary leaf; returns its slot reference.
+fn leaf_slot(leaf: &BinaryNode, out: &mut Collapse) -> u32 {
     let Kind::Leaf { start, count } = leaf.kind else {
         unreachable!("a leaf")
     };
-    let first = out.packets.len() as u32;
-    for chunk in tree.refs[start as usize..(start + count) as usize].chunks(LANES) {
-        let mut ids = [0u32; LANES];
-        for (id, r) in ids.iter_mut().zip(chunk) {
-            *id = r.prim;
-        }
-        out.packets.push(Packet::new(prims, &ids[..chunk.len()]));
+    let first = out.packet_refs.len() as u32;
+    for k in (0..count).step_by(LANES) {
+        out.packet_refs.push((start + k, (count - k).min(LANES as u32)));
     }
-    let n = out.packets.len() as u32 - first;
+    let n = out.packet_refs.len() as u32 - first;
     assert!(
         first <= FIRST_MASK,
         "too many primitives for the BVH's 28-bit packet index"
@@ -123,11 +147,12 @@ fn leaf_slot<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, leaf: &BinaryNode, pri
 }
 
 /// Builds the wide node standing for interior binary node `b`; returns its index.
-fn collapse_node<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, b: u32, prims: &P, out: &mut WideTree) -> u32 {
+fn collapse_node(tree: &BinaryTree, b: u32, out: &mut Collapse) -> u32 {
     let Kind::Interior { left, right } = tree.nodes[b as usize].kind else {
         unreachable!("interior")
     };
-    let mut children = vec![left, right];
+    let mut children = Vec::with_capacity(WIDTH);
+    children.extend([left, right]);
     while children.len() < WIDTH {
         // Open the interior child with the largest surface area.
         let widest = children
@@ -151,18 +176,18 @@ fn collapse_node<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, b: u32, prims: &P,
     for (slot, &c) in children.iter().enumerate() {
         let child = &tree.nodes[c as usize];
         let reference = match child.kind {
-            Kind::Leaf { .. } => leaf_slot(tree, child, prims, out),
+            Kind::Leaf { .. } => leaf_slot(child, out),
             Kind::Interior { .. } if let Some((start, count)) = small_subtree(tree, c) => {
                 let merged = BinaryNode {
                     bounds: child.bounds,
                     kind: Kind::Leaf { start, count },
                 };
-                leaf_slot(tree, &merged, prims, out)
+                leaf_slot(&merged, out)
             }
             Kind::Interior { .. } => {
                 // Interior children are referenced by byte offset: traversal then needs
                 // no multiplication between loading a reference and loading the node.
-                let offset = collapse_node(tree, c, prims, out) as usize * std::mem::size_of::<WideNode>();
+                let offset = collapse_node(tree, c, out) as usize * std::mem::size_of::<WideNode>();
                 assert!(
                     offset < LEAF as usize,
                     "too many nodes for the BVH's 31-bit node offsets"
