@@ -11,10 +11,12 @@
 //! centroids, nodes are split at the object median so the depth stays bounded. The build works on a flat array of 32-byte references that it
 //! partitions in place: no allocation per node and no indirection.
 //!
-//! Subtrees of more than [`PARALLEL_REFS`] references are built on two threads at once
+//! With more than one thread, subtrees of more than [`PARALLEL_REFS`] references (and
+//! more than a few dozenth of the whole per thread) are built on two threads at once
 //! (`rayon::join`): each side into its own list of nodes, joined as parent, left
 //! subtree, right subtree — the very order the one-thread recursion writes — so the tree
-//! is the same, node for node, for any number of threads.
+//! is the same, node for node, for any number of threads. One thread writes every node
+//! in place (each join copies its subtrees' nodes once more).
 
 use crate::aabb::Aabb;
 use crate::math::Vec3A;
@@ -29,8 +31,8 @@ pub const MAX_LEAF: usize = 4;
 /// dragons: 2 beats 0.5 and 1, and gives smaller trees; 3 and 4 are no better).
 const TRAVERSAL_COST: f32 = 2.0;
 const MEDIAN_SPLIT_DEPTH: usize = 48;
-/// Subtrees larger than this are built with their two halves in parallel; smaller ones
-/// are not worth a task.
+/// Subtrees larger than this may be built with their two halves in parallel; smaller
+/// ones are not worth a task.
 const PARALLEL_REFS: usize = 4096;
 /// Nodes over more references than this bin them on the pool's threads, in chunks whose
 /// bins are then merged (exactly: minima, maxima and counts).
@@ -157,12 +159,25 @@ pub fn build(items: impl Iterator<Item = (u32, Aabb)>) -> BinaryTree {
 /// Builds over the references `refs` (in this order: the tree depends on it).
 pub fn build_refs(refs: Vec<BuildRef>) -> BinaryTree {
     let mut tree = BinaryTree {
-        nodes: Vec::with_capacity(refs.len() / 2 + 1),
+        // About two nodes for every three references (leaves hold three on average);
+        // pages never written are never touched.
+        nodes: Vec::with_capacity(refs.len() + 1),
         refs,
     };
     if !tree.refs.is_empty() {
         let (b, c) = parallel_bounds(&tree.refs);
-        tree.nodes = build_subtree(&mut tree.refs, 0, b, c, 0);
+        let threads = rayon::current_num_threads();
+        if threads == 1 {
+            let n = tree.refs.len();
+            let mut refs = std::mem::take(&mut tree.refs);
+            build_node(&mut tree, &mut refs, 0, 0, n, b, c, 0);
+            tree.refs = refs;
+        } else {
+            // Enough tasks to keep every thread busy, few enough that the joins do not
+            // copy the nodes over and over.
+            let parallel = PARALLEL_REFS.max(tree.refs.len() / (8 * threads));
+            tree.nodes = build_subtree(&mut tree.refs, 0, b, c, 0, parallel);
+        }
     }
     tree
 }
@@ -188,8 +203,15 @@ fn parallel_bounds(refs: &[BuildRef]) -> (Aabb, Aabb) {
 
 /// The nodes of the subtree over `refs` (which start at index `offset` of the whole
 /// array), its root first; their child indices count from that root.
-fn build_subtree(refs: &mut [BuildRef], offset: usize, bounds: Aabb, cb: Aabb, depth: usize) -> Vec<BinaryNode> {
-    if refs.len() <= PARALLEL_REFS {
+fn build_subtree(
+    refs: &mut [BuildRef],
+    offset: usize,
+    bounds: Aabb,
+    cb: Aabb,
+    depth: usize,
+    parallel: usize,
+) -> Vec<BinaryNode> {
+    if refs.len() <= parallel {
         let mut tree = BinaryTree {
             nodes: Vec::with_capacity(refs.len() / 2 + 1),
             refs: Vec::new(),
@@ -210,8 +232,8 @@ fn build_subtree(refs: &mut [BuildRef], offset: usize, bounds: Aabb, cb: Aabb, d
     };
     let (l, r) = refs.split_at_mut(split.mid);
     let (left, right) = rayon::join(
-        || build_subtree(l, offset, split.left.0, split.left.1, depth + 1),
-        || build_subtree(r, offset + split.mid, split.right.0, split.right.1, depth + 1),
+        || build_subtree(l, offset, split.left.0, split.left.1, depth + 1, parallel),
+        || build_subtree(r, offset + split.mid, split.right.0, split.right.1, depth + 1, parallel),
     );
     // Parent, left subtree, right subtree: the order of the one-thread recursion.
     let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
