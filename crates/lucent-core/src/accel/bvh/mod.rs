@@ -23,7 +23,7 @@ mod ray_triangle;
 mod traverse;
 mod wide;
 
-use super::{Accelerator, PrimitiveSet};
+use super::{huge_pages, Accelerator, PrimitiveSet};
 use crate::hit::Hit;
 use crate::ray::{PreparedRay, Ray};
 use packet::Packet;
@@ -100,15 +100,17 @@ impl Bvh {
     /// Builds for a given instruction set (tests use this to check every path).
     pub fn build_for<P: PrimitiveSet + ?Sized>(prims: &P, isa: Isa) -> Bvh {
         // The references in primitive order, their boxes computed on the pool's threads.
-        let mut refs: Vec<binary::BuildRef> = {
+        let mut refs: Vec<binary::BuildRef> = huge_pages::vec_with_capacity(prims.count());
+        {
             use rayon::prelude::*;
             // Indexed, so the references are written in place (a filtered parallel
             // iterator would gather chunks and copy them once more).
-            (0..prims.count() as u32)
-                .into_par_iter()
-                .map(|i| binary::BuildRef::new(&prims.bounds(i), i))
-                .collect()
-        };
+            refs.par_extend(
+                (0..prims.count() as u32)
+                    .into_par_iter()
+                    .map(|i| binary::BuildRef::new(&prims.bounds(i), i)),
+            );
+        }
         refs.retain(|r| super::is_bounded(&r.bounds()));
         let tree = binary::build_refs(refs);
         let wide = wide::collapse(&tree, prims);

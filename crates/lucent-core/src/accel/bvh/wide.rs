@@ -54,7 +54,7 @@ pub struct WideTree {
 
 pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
     let mut out = Collapse {
-        nodes: Vec::with_capacity(tree.nodes.len() / 4 + 1),
+        nodes: crate::accel::huge_pages::vec_with_capacity(tree.nodes.len() / 4 + 1),
         packet_refs: Vec::with_capacity(prims.count() / 3 + 1),
     };
     if let Some(root) = tree.nodes.first() {
@@ -73,20 +73,18 @@ pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideT
     // The packets' corners are gathered from the primitives (scattered reads, most of
     // the collapse's time) on the pool's threads, each written in its place: the same
     // packets for any number of threads.
-    let packets = {
+    let mut packets = crate::accel::huge_pages::vec_with_capacity(out.packet_refs.len());
+    {
         use rayon::prelude::*;
-        out.packet_refs
-            .par_iter()
-            .map(|&(start, count)| {
-                let mut ids = [0u32; LANES];
-                let chunk = &tree.refs[start as usize..(start + count) as usize];
-                for (id, r) in ids.iter_mut().zip(chunk) {
-                    *id = r.prim;
-                }
-                Packet::new(prims, &ids[..chunk.len()])
-            })
-            .collect()
-    };
+        packets.par_extend(out.packet_refs.par_iter().map(|&(start, count)| {
+            let mut ids = [0u32; LANES];
+            let chunk = &tree.refs[start as usize..(start + count) as usize];
+            for (id, r) in ids.iter_mut().zip(chunk) {
+                *id = r.prim;
+            }
+            Packet::new(prims, &ids[..chunk.len()])
+        }));
+    }
     WideTree {
         nodes: out.nodes,
         packets,
