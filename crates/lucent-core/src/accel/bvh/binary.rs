@@ -8,15 +8,16 @@
 //! cheaper than its own packets. (Only the planes between occupied bins are priced, and a
 //! node of one packet is a leaf without binning: the same choices, for less.) Below
 //! depth 48 (only pathological inputs get there), and when no plane separates the
-//! centroids, nodes are split at the object median so the depth stays bounded. The build works on a flat array of 32-byte references that it
-//! partitions in place: no allocation per node and no indirection.
+//! centroids, nodes are split at the object median so the depth stays bounded. The build
+//! works on a flat array of 32-byte references that it partitions in place: no
+//! allocation per node and no indirection.
 //!
 //! With more than one thread, subtrees of more than [`PARALLEL_REFS`] references (and
-//! more than a few dozenth of the whole per thread) are built on two threads at once
-//! (`rayon::join`): each side into its own list of nodes, joined as parent, left
-//! subtree, right subtree — the very order the one-thread recursion writes — so the tree
-//! is the same, node for node, for any number of threads. One thread writes every node
-//! in place (each join copies its subtrees' nodes once more).
+//! more than an eighth of the whole per thread) are built on two threads at once
+//! (`rayon::join`): each side into its own lists of nodes, put together at the end as
+//! parent, left subtree, right subtree — the very order the one-thread recursion writes
+//! — so the tree is the same, node for node, for any number of threads. One thread
+//! writes every node in place.
 
 use crate::aabb::Aabb;
 use crate::math::Vec3A;
@@ -176,7 +177,18 @@ pub fn build_refs(refs: Vec<BuildRef>) -> BinaryTree {
             // Enough tasks to keep every thread busy, few enough that the joins do not
             // copy the nodes over and over.
             let parallel = PARALLEL_REFS.max(tree.refs.len() / (8 * threads));
-            tree.nodes = build_subtree(&mut tree.refs, 0, b, c, 0, parallel);
+            let parts = build_subtree(&mut tree.refs, 0, b, c, 0, parallel);
+            // Each part moves into place once, its child indices rebased.
+            for part in parts {
+                let base = tree.nodes.len() as u32;
+                tree.nodes.extend(part.into_iter().map(|mut n| {
+                    if let Kind::Interior { left, right } = &mut n.kind {
+                        *left += base;
+                        *right += base;
+                    }
+                    n
+                }));
+            }
         }
     }
     tree
@@ -202,7 +214,9 @@ fn parallel_bounds(refs: &[BuildRef]) -> (Aabb, Aabb) {
 }
 
 /// The nodes of the subtree over `refs` (which start at index `offset` of the whole
-/// array), its root first; their child indices count from that root.
+/// array) in the one-thread order, its root first, as consecutive parts: each part's
+/// child indices count from the part's first node. (The parts are only put together
+/// at the end, so that no node is copied more than once.)
 fn build_subtree(
     refs: &mut [BuildRef],
     offset: usize,
@@ -210,14 +224,14 @@ fn build_subtree(
     cb: Aabb,
     depth: usize,
     parallel: usize,
-) -> Vec<BinaryNode> {
+) -> Vec<Vec<BinaryNode>> {
     if refs.len() <= parallel {
         let mut tree = BinaryTree {
-            nodes: Vec::with_capacity(refs.len() / 2 + 1),
+            nodes: Vec::with_capacity(refs.len() + 1),
             refs: Vec::new(),
         };
         build_node(&mut tree, refs, offset, 0, refs.len(), bounds, cb, depth);
-        return tree.nodes;
+        return vec![tree.nodes];
     }
     let count = refs.len();
     let leaf = BinaryNode {
@@ -228,33 +242,27 @@ fn build_subtree(
         },
     };
     let Some(split) = choose_split(refs, &bounds, &cb, depth) else {
-        return vec![leaf];
+        return vec![vec![leaf]];
     };
     let (l, r) = refs.split_at_mut(split.mid);
     let (left, right) = rayon::join(
         || build_subtree(l, offset, split.left.0, split.left.1, depth + 1, parallel),
         || build_subtree(r, offset + split.mid, split.right.0, split.right.1, depth + 1, parallel),
     );
-    // Parent, left subtree, right subtree: the order of the one-thread recursion.
-    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
-    nodes.push(BinaryNode {
+    // Parent, left subtree, right subtree: the order of the one-thread recursion. The
+    // parent is a part of its own, its children counted from it.
+    let left_len: usize = left.iter().map(Vec::len).sum();
+    let mut parts = Vec::with_capacity(1 + left.len() + right.len());
+    parts.push(vec![BinaryNode {
         bounds,
         kind: Kind::Interior {
             left: 1,
-            right: 1 + left.len() as u32,
+            right: 1 + left_len as u32,
         },
-    });
-    for part in [left, right] {
-        let base = nodes.len() as u32;
-        nodes.extend(part.into_iter().map(|mut n| {
-            if let Kind::Interior { left, right } = &mut n.kind {
-                *left += base;
-                *right += base;
-            }
-            n
-        }));
-    }
-    nodes
+    }]);
+    parts.extend(left);
+    parts.extend(right);
+    parts
 }
 
 /// Where to split `refs` (partitioning them), or `None` for a leaf.
