@@ -13,7 +13,7 @@
 //! allocation per node and no indirection.
 //!
 //! With more than one thread, subtrees of more than [`PARALLEL_REFS`] references (and
-//! more than an eighth of the whole per thread) are built on two threads at once
+//! more than an eighth of one thread's share of the whole) are built on two threads at once
 //! (`rayon::join`): each side into its own lists of nodes, put together at the end as
 //! parent, left subtree, right subtree — the very order the one-thread recursion writes
 //! — so the tree is the same, node for node, for any number of threads. One thread
