@@ -85,11 +85,16 @@ pub fn one_light_mis(
     counts: &mut TraceCounts,
 ) -> Color {
     let count = scene.sampled_light_count();
-    let pick = sampler.uniform();
-    let (u, v) = sampler.uniform2();
     if count == 0 {
         return Color::ZERO;
     }
+    // A number to choose the light (and its piece) only where there is a choice.
+    let pick = if count > 1 || scene.sampled_light(0).has_pieces() {
+        sampler.uniform()
+    } else {
+        0.0
+    };
+    let (u, v) = sampler.uniform2();
     let scaled = pick * count as f32;
     let index = (scaled as usize).min(count - 1);
     // What is left of `pick` within the chosen light chooses its piece.

@@ -96,7 +96,11 @@ impl PathTracer {
     /// below the surface: by the shading normal or by the true surface at `x`).
     fn bounce(&self, x: &SurfacePoint, bsdf: &Bsdf, wo: Vec3A, sampler: &mut Sampler) -> Option<Bounce> {
         let n = bsdf.normal();
-        let pick = sampler.uniform();
+        // A number to choose the lobe only where there is a choice.
+        let pick = match self.sampling {
+            DirectionSampling::Brdf if !bsdf.has_one_lobe() => sampler.uniform(),
+            _ => 0.0,
+        };
         let (u, v) = sampler.uniform2();
         let (wi, f, pdf) = match self.sampling {
             DirectionSampling::Hemisphere => {

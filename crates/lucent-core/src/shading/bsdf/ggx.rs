@@ -32,7 +32,7 @@ impl Ggx {
     /// The probability of drawing from the microfacet lobe: even a black `specular`
     /// reflects at grazing angles through F.
     #[inline]
-    fn specular_share(&self) -> f32 {
+    pub(super) fn specular_share(&self) -> f32 {
         let (d, s) = (mean(self.kd), mean(self.ks));
         if d + s > 0.0 {
             (s / (d + s)).max(0.25)

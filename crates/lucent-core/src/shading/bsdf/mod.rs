@@ -116,6 +116,17 @@ impl Bsdf {
         }
     }
 
+    /// Whether [`Bsdf::sample`] has only one lobe to draw from, so that its `pick` does
+    /// not matter (0 picks that lobe): the path tracer then draws no number for it.
+    #[inline]
+    pub fn has_one_lobe(&self) -> bool {
+        match self {
+            Bsdf::Phong(b) => matches!(b.specular_share(), 0.0 | 1.0),
+            Bsdf::Ggx(b) => b.specular_share() == 1.0,
+            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => true,
+        }
+    }
+
     /// A direction drawn in proportion to the BSDF (`importancesampling brdf`): `pick`
     /// chooses the lobe, `(u, v)` the direction in it. `None` when nothing can be drawn
     /// (and for delta BSDFs: see [`Bsdf::sample_delta`]).

@@ -27,7 +27,7 @@ pub struct Phong {
 impl Phong {
     /// The probability of drawing from the specular lobe.
     #[inline]
-    fn specular_share(&self) -> f32 {
+    pub(super) fn specular_share(&self) -> f32 {
         let (d, s) = (mean(self.kd), mean(self.ks));
         if d + s > 0.0 {
             s / (d + s)
