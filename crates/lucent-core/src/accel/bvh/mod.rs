@@ -5,8 +5,8 @@
 //! children whose boxes are stored as structure-of-arrays; leaves become packets of four
 //! primitives with precomputed triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): eight box tests per visit with AVX2 and FMA when the CPU
-//! has them (decided once, at build time, with `is_x86_feature_detected!`), two SSE
+//! Traversal ([`traverse`]): eight box tests per visit ([`box_test`]) with AVX2 and FMA
+//! when the CPU has them (decided once, at build time, with `is_x86_feature_detected!`), two SSE
 //! halves when not; nearest child first, an explicit fixed-size stack, no allocation per
 //! ray; the packet test is bit-identical to the scalar watertight triangle test, so the answers
 //! are exactly the brute-force list's.
@@ -15,6 +15,7 @@
 //! sixteen with AVX-512 ([`Bvh::closest_hits`], [`Bvh::occluded_rays`]).
 
 mod binary;
+mod box_test;
 mod lanes;
 mod packet;
 mod ray_lanes;
@@ -26,8 +27,8 @@ mod wide;
 use super::{huge_pages, Accelerator, PrimitiveSet};
 use crate::hit::Hit;
 use crate::ray::{PreparedRay, Ray};
+use box_test::{BoxTest, FmaOffsets, RayBoxes, Slab};
 use packet::Packet;
-use traverse::{BoxTest, FmaOffsets, RayBoxes, Slab};
 use wide::WideNode;
 
 /// The instruction set the traversal uses on this CPU.
@@ -245,8 +246,8 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
 unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
     // The ray's constants are made here, in this function, rather than passed in: handing
     // them over through memory costs a stalled store-to-load forward per ray.
+    use box_test::Fused;
     use lanes::Avx;
-    use traverse::Fused;
     let rb = RayBoxes::new(r);
     if let Some(offsets) = FmaOffsets::new(r) {
         Q::run::<Fused<Avx>, false>(b, prims, r, &Fused::prepare(&rb, &offsets))

@@ -19,10 +19,11 @@
 //! ray's answer. Rays without the fused test's constants (an axis they do not move along,
 //! a constant that is not finite, a negative `t_min`) are traced alone.
 
+use super::box_test::FmaOffsets;
 use super::packet::{LaneKind, Lanes as Bits, Packet};
 use super::ray_lanes::RayLanes;
 use super::ray_triangle::{self, ShearedRays};
-use super::traverse::{leaf_packets, FmaOffsets};
+use super::traverse::leaf_packets;
 use super::wide::{WideNode, EMPTY, LEAF, WIDTH};
 use crate::accel::{PrimitiveSet, SEARCH_SLACK};
 use crate::hit::Hit;
