@@ -9,23 +9,22 @@
 //! node of one packet is a leaf without binning: the same choices, for less.) Below
 //! depth 48 (only pathological inputs get there), and when no plane separates the
 //! centroids, nodes are split at the object median so the depth stays bounded. The build
-//! works on a flat array of 32-byte references that it partitions in place: no
-//! allocation per node and no indirection.
+//! works on a flat array of 32-byte references ([`super::build_ref`]) that it partitions
+//! in place: no allocation per node and no indirection. Binning and pricing planes are
+//! [`super::sah_bins`].
 //!
 //! With more than one thread, subtrees of more than [`PARALLEL_REFS`] references (and
-//! more than an eighth of one thread's share of the whole) are built on two threads at once
-//! (`rayon::join`): each side into its own lists of nodes, put together at the end as
+//! more than an eighth of one thread's share of the whole) are built on two threads at
+//! once (`rayon::join`): each side into its own lists of nodes, put together at the end as
 //! parent, left subtree, right subtree — the very order the one-thread recursion writes
 //! — so the tree is the same, node for node, for any number of threads. One thread
 //! writes every node in place.
 
+use super::build_ref::BuildRef;
+use super::sah_bins::{area, bin_node, cheapest_plane, packets, side_bounds, PARALLEL_BINNING};
 use crate::aabb::Aabb;
 use crate::math::Vec3A;
 
-use super::packet::LANES;
-
-const BINS: usize = 16;
-const _: () = assert!(BINS.is_power_of_two(), "bin indices are masked with BINS - 1");
 /// Leaves hold at most this many primitives (one packet; the collapse may merge two).
 pub const MAX_LEAF: usize = 4;
 /// Cost of one traversal step relative to one packet test (measured on the benchmark
@@ -35,76 +34,6 @@ const MEDIAN_SPLIT_DEPTH: usize = 48;
 /// Subtrees larger than this may be built with their two halves in parallel; smaller
 /// ones are not worth a task.
 const PARALLEL_REFS: usize = 4096;
-/// Nodes over more references than this bin them on the pool's threads, in chunks whose
-/// bins are then merged (exactly: minima, maxima and counts).
-const PARALLEL_BINNING: usize = 1 << 16;
-
-/// A primitive's box and index, as the builder moves them around.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(32))]
-pub struct BuildRef {
-    pub lo: [f32; 3],
-    pub prim: u32,
-    pub hi: [f32; 3],
-    /// The reference's bin along x, y and z at the last binning (4 bits each), so that
-    /// the partition reads its side instead of computing it again.
-    bins: u32,
-}
-
-impl BuildRef {
-    pub fn new(b: &Aabb, prim: u32) -> BuildRef {
-        BuildRef {
-            lo: b.min.into(),
-            prim,
-            hi: b.max.into(),
-            bins: 0,
-        }
-    }
-    #[inline(always)]
-    fn lo(&self) -> Vec3A {
-        load_xyz::<0>(self)
-    }
-    #[inline(always)]
-    fn hi(&self) -> Vec3A {
-        load_xyz::<1>(self)
-    }
-    pub fn bounds(&self) -> Aabb {
-        Aabb {
-            min: self.lo(),
-            max: self.hi(),
-        }
-    }
-    /// Twice the centroid (the factor ½ cancels in every use).
-    #[inline(always)]
-    fn centroid2(&self) -> Vec3A {
-        self.lo() + self.hi()
-    }
-}
-
-/// Half `HALF` of a reference (0: `lo` and `prim`, 1: `hi` and `bins`) as a vector of
-/// its three floats: one aligned load on x86-64, the fourth lane cleared (the builder
-/// reads references some hundred million times; assembling three scalars costs more).
-#[inline(always)]
-fn load_xyz<const HALF: usize>(r: &BuildRef) -> Vec3A {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a `BuildRef` is 32 bytes, 32-byte aligned, with `lo` at offset 0 and `hi`
-    // at 16 (asserted below): both halves are aligned, readable 16-byte groups; the
-    // fourth float of each (`prim` or `bins`) is masked off.
-    unsafe {
-        use std::arch::x86_64::*;
-        let xyz = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
-        let half = (r as *const BuildRef as *const f32).add(4 * HALF);
-        Vec3A::from(_mm_and_ps(_mm_load_ps(half), xyz))
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    Vec3A::from_array(if HALF == 0 { r.lo } else { r.hi })
-}
-
-const _: () = assert!(
-    std::mem::offset_of!(BuildRef, lo) == 0
-        && std::mem::offset_of!(BuildRef, hi) == 16
-        && std::mem::size_of::<BuildRef>() == 32
-);
 
 #[derive(Clone, Copy, Debug)]
 pub enum Kind {
@@ -129,26 +58,6 @@ pub struct BinaryNode {
 pub struct BinaryTree {
     pub nodes: Vec<BinaryNode>,
     pub refs: Vec<BuildRef>,
-}
-
-/// Truncates three non-negative bin coordinates at once (one SIMD conversion on x86-64).
-#[inline(always)]
-fn bin_indices(v: Vec3A) -> [u32; 4] {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE2 is part of x86-64; the values are in [0, BINS) or NaN (→ 0x80000000,
-    // masked to a valid bin by the caller).
-    unsafe {
-        use std::arch::x86_64::*;
-        let i = _mm_cvttps_epi32(v.into());
-        std::mem::transmute::<__m128i, [u32; 4]>(i)
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    [v.x as u32, v.y as u32, v.z as u32, 0]
-}
-
-#[inline(always)]
-fn packets(n: usize) -> f32 {
-    n.div_ceil(LANES) as f32
 }
 
 /// Builds over `(primitive index, bounds)` pairs.
@@ -333,84 +242,6 @@ struct Split {
     right: (Aabb, Aabb),
 }
 
-#[derive(Clone, Copy)]
-struct Bin {
-    lo: Vec3A,
-    hi: Vec3A,
-    count: u32,
-}
-
-const EMPTY_BIN: Bin = Bin {
-    lo: Vec3A::INFINITY,
-    hi: Vec3A::NEG_INFINITY,
-    count: 0,
-};
-
-fn area(lo: Vec3A, hi: Vec3A) -> f32 {
-    let e = (hi - lo).max(Vec3A::ZERO);
-    e.x * e.y + e.y * e.z + e.z * e.x
-}
-
-type Bins = [[Bin; BINS]; 3];
-
-/// Sorts the references' centroids into bins along the three axes (and notes each
-/// one's bins in it).
-fn bin_refs(refs: &mut [BuildRef], lo: Vec3A, scale: Vec3A) -> Bins {
-    if refs.len() < TWO_BIN_SETS {
-        let mut bins = [[EMPTY_BIN; BINS]; 3];
-        for r in refs.iter_mut() {
-            bin_ref(&mut bins, r, lo, scale);
-        }
-        return bins;
-    }
-    // Neighbouring references mostly fall into the same bins, and each bin update waits
-    // for the one before it (load, min, store): alternating between two sets of bins
-    // halves that chain. Merging them is exact (minima, maxima, counts).
-    let (mut even, mut odd) = ([[EMPTY_BIN; BINS]; 3], [[EMPTY_BIN; BINS]; 3]);
-    let mut pairs = refs.chunks_exact_mut(2);
-    for pair in &mut pairs {
-        let [a, b] = pair else { unreachable!("pairs") };
-        bin_ref(&mut even, a, lo, scale);
-        bin_ref(&mut odd, b, lo, scale);
-    }
-    for r in pairs.into_remainder() {
-        bin_ref(&mut even, r, lo, scale);
-    }
-    merge_bins(even, odd)
-}
-
-/// Nodes over at least this many references bin them into two sets of bins.
-const TWO_BIN_SETS: usize = 64;
-
-/// Adds one reference to `bins` and notes its bins in it.
-#[inline(always)]
-fn bin_ref(bins: &mut Bins, r: &mut BuildRef, lo: Vec3A, scale: Vec3A) {
-    let max_bin = Vec3A::splat((BINS - 1) as f32);
-    // Both halves are read once, before `bins` is written (a 16-byte load of the half
-    // that holds a 4-byte store still in flight waits for it).
-    let (rlo, rhi) = (r.lo(), r.hi());
-    let b = bin_indices(((rlo + rhi - lo) * scale).min(max_bin)).map(|i| i as usize & (BINS - 1));
-    for (axis, bin_axis) in bins.iter_mut().enumerate() {
-        let bin = &mut bin_axis[b[axis]];
-        bin.lo = bin.lo.min(rlo);
-        bin.hi = bin.hi.max(rhi);
-        bin.count += 1;
-    }
-    r.bins = (b[0] | b[1] << 4 | b[2] << 8) as u32;
-}
-
-/// The bins of two groups of references together.
-fn merge_bins(mut a: Bins, b: Bins) -> Bins {
-    for (axis_a, axis_b) in a.iter_mut().zip(&b) {
-        for (x, y) in axis_a.iter_mut().zip(axis_b) {
-            x.lo = x.lo.min(y.lo);
-            x.hi = x.hi.max(y.hi);
-            x.count += y.count;
-        }
-    }
-    a
-}
-
 /// Partitions at the best SAH plane, or returns `None` when a leaf is cheaper (or no
 /// plane separates the centroids).
 fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
@@ -421,109 +252,24 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
     if count <= MAX_LEAF && TRAVERSAL_COST >= packets(count) {
         return None;
     }
-    let extent = cb.max - cb.min;
-    let lo = cb.min;
-    // Axes with no extent get scale 0: everything lands in bin 0 and no plane is priced.
-    let scale = Vec3A::select(
-        extent.cmpgt(Vec3A::ZERO),
-        Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / extent,
-        Vec3A::ZERO,
-    );
-    let bins = if count > PARALLEL_BINNING {
-        use rayon::prelude::*;
-        refs.par_chunks_mut(PARALLEL_BINNING / 4)
-            .map(|chunk| bin_refs(chunk, lo, scale))
-            .reduce(|| [[EMPTY_BIN; BINS]; 3], merge_bins)
-    } else {
-        bin_refs(refs, lo, scale)
-    };
+    let (bins, scale) = bin_node(refs, cb);
     let (cost, axis, split_bin) = cheapest_plane(&bins, scale)?;
     let a = area(bounds.min, bounds.max);
     let split_cost = TRAVERSAL_COST + if a > 0.0 { cost / a } else { packets(count) };
     if count <= MAX_LEAF && split_cost >= packets(count) {
         return None;
     }
-    let shift = 4 * axis as u32;
-    let goes_left = |r: &BuildRef| ((r.bins >> shift) as usize & (BINS - 1)) < split_bin;
-    let (mid, centroids) = partition_with_centroids(refs, goes_left);
+    let (mid, centroids) = partition_with_centroids(refs, |r| r.bin(axis) < split_bin);
     if mid == 0 || mid == count {
         return None;
     }
-    // The children's boxes are the unions of their bins' boxes (min and max are exact:
-    // the same bits as scanning the references again); their centroid bounds came from
-    // the partition.
-    let union = |bins: &[Bin]| {
-        bins.iter().fold(
-            Aabb {
-                min: Vec3A::INFINITY,
-                max: Vec3A::NEG_INFINITY,
-            },
-            |b, bin| Aabb {
-                min: b.min.min(bin.lo),
-                max: b.max.max(bin.hi),
-            },
-        )
-    };
-    let bins = &bins[axis];
+    // The children's boxes come from the bins, their centroid bounds from the partition.
+    let (left, right) = side_bounds(&bins, axis, split_bin);
     Some(Split {
         mid,
-        left: (union(&bins[..split_bin]), centroids[0]),
-        right: (union(&bins[split_bin..]), centroids[1]),
+        left: (left, centroids[0]),
+        right: (right, centroids[1]),
     })
-}
-
-/// No plane chosen (see [`cheapest_plane`]).
-const NO_PLANE: u32 = u32::MAX;
-
-/// The cheapest plane of `bins` by the SAH, as (cost, axis, first bin on the right);
-/// `None` when no plane has references on both sides. Axes of `scale` 0 are not split.
-fn cheapest_plane(bins: &Bins, scale: Vec3A) -> Option<(f32, usize, usize)> {
-    // The cheapest plane so far, as its cost and `axis << 8 | first bin on the right`
-    // (none yet: cost ∞), chosen without branches: which candidate wins is data, and a
-    // mispredicted branch per win cost more than the pricing.
-    let (mut best_cost, mut best_plane) = (f32::INFINITY, NO_PLANE);
-    for axis in 0..3 {
-        if scale[axis] == 0.0 {
-            continue;
-        }
-        let bins = &bins[axis];
-        // Only planes between two occupied bins can split, and all planes in one gap
-        // between them make the same two sides at the same cost: pricing the lowest plane
-        // of each gap, in order, finds the split that pricing every plane finds (its
-        // folds skip only empty bins, which change no bit), at the cost of the occupied
-        // bins alone — few in the many small nodes near the leaves.
-        let mut occupied = [0u8; BINS];
-        let mut m = 0;
-        for (k, bin) in bins.iter().enumerate() {
-            occupied[m] = k as u8;
-            m += (bin.count > 0) as usize;
-        }
-        let occupied = &occupied[..m];
-        // right_cost[t]: the bins occupied[t..] on the right.
-        let mut right_cost = [0.0f32; BINS];
-        let (mut rlo, mut rhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
-        for t in (1..m).rev() {
-            let bin = &bins[occupied[t] as usize];
-            rlo = rlo.min(bin.lo);
-            rhi = rhi.max(bin.hi);
-            n += bin.count as usize;
-            right_cost[t] = area(rlo, rhi) * packets(n);
-        }
-        let (mut llo, mut lhi, mut n) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize);
-        for t in 1..m {
-            let bin = &bins[occupied[t - 1] as usize];
-            llo = llo.min(bin.lo);
-            lhi = lhi.max(bin.hi);
-            n += bin.count as usize;
-            let cost = area(llo, lhi) * packets(n) + right_cost[t];
-            // (A NaN or infinite cost, from areas past f32's range, never wins.)
-            let better = cost < best_cost;
-            best_cost = if better { cost } else { best_cost };
-            let plane = (axis as u32) << 8 | (occupied[t - 1] as u32 + 1);
-            best_plane = if better { plane } else { best_plane };
-        }
-    }
-    (best_plane != NO_PLANE).then_some((best_cost, (best_plane >> 8) as usize, (best_plane & 0xff) as usize))
 }
 
 /// In-place partition (Hoare style): how many elements satisfy `pred` (they come first),
@@ -579,24 +325,8 @@ fn median_split(refs: &mut [BuildRef], cb: &Aabb) -> Split {
 
 #[cfg(test)]
 mod tests {
+    use super::super::sah_bins::tests::boxes;
     use super::*;
-
-    fn boxes(n: u32) -> Vec<(u32, Aabb)> {
-        let mut x = 0x9e37_79b9u32;
-        let mut next = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            x as f32 / u32::MAX as f32
-        };
-        (0..n)
-            .map(|i| {
-                let c = Vec3A::new(next(), next(), next()) * 100.0;
-                let e = Vec3A::new(next(), next(), next());
-                (i, Aabb { min: c - e, max: c + e })
-            })
-            .collect()
-    }
 
     /// Nodes and leaf order as plain values, to compare trees.
     fn shape(t: &BinaryTree) -> (Vec<String>, Vec<u32>) {
@@ -604,82 +334,6 @@ mod tests {
             t.nodes.iter().map(|n| format!("{n:?}")).collect(),
             t.refs.iter().map(|r| r.prim).collect(),
         )
-    }
-
-    /// Every one of the 15 planes per axis priced, empty bins folded in (the plain
-    /// binned SAH), the first cheapest one kept.
-    fn cheapest_of_every_plane(bins: &Bins, scale: Vec3A) -> Option<(f32, usize, usize)> {
-        let mut best: Option<(f32, usize, usize)> = None;
-        for axis in (0..3).filter(|&a| scale[a] != 0.0) {
-            let bins = &bins[axis];
-            for k in 1..BINS {
-                let side = |range: &[Bin]| {
-                    range
-                        .iter()
-                        .fold((Vec3A::INFINITY, Vec3A::NEG_INFINITY, 0usize), |(lo, hi, n), b| {
-                            (lo.min(b.lo), hi.max(b.hi), n + b.count as usize)
-                        })
-                };
-                let (llo, lhi, nl) = side(&bins[..k]);
-                let (rlo, rhi, nr) = side(&bins[k..]);
-                let cost = area(llo, lhi) * packets(nl) + area(rlo, rhi) * packets(nr);
-                if nl > 0 && nr > 0 && best.is_none_or(|(c, _, _)| cost < c) {
-                    best = Some((cost, axis, k));
-                }
-            }
-        }
-        best
-    }
-
-    #[test]
-    fn pricing_only_occupied_gaps_finds_the_plane_every_plane_finds() {
-        for n in [2, 3, 5, 8, 13, 17, 40, 100, 300] {
-            for seed in 0..20 {
-                // Boxes clustered on a few spots, so many bins stay empty and many
-                // planes tie.
-                let mut refs: Vec<BuildRef> = boxes(n + seed * 7)
-                    .into_iter()
-                    .skip(seed as usize * 7)
-                    .map(|(i, b)| {
-                        let snapped = Aabb {
-                            min: (b.min / 25.0).round() * 25.0,
-                            max: (b.min / 25.0).round() * 25.0 + (b.max - b.min),
-                        };
-                        BuildRef::new(if seed % 2 == 0 { &snapped } else { &b }, i)
-                    })
-                    .collect();
-                let (_, cb) = range_bounds(&refs);
-                let extent = cb.max - cb.min;
-                let scale = Vec3A::select(
-                    extent.cmpgt(Vec3A::ZERO),
-                    Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / extent,
-                    Vec3A::ZERO,
-                );
-                let bins = bin_refs(&mut refs, cb.min, scale);
-                let fast = cheapest_plane(&bins, scale).map(|(c, a, k)| (c.to_bits(), a, k));
-                let every = cheapest_of_every_plane(&bins, scale).map(|(c, a, k)| (c.to_bits(), a, k));
-                assert_eq!(fast, every, "{n} boxes, seed {seed}");
-            }
-        }
-    }
-
-    #[test]
-    fn two_sets_of_bins_bin_as_one() {
-        let mut refs: Vec<BuildRef> = boxes(1000).iter().map(|(i, b)| BuildRef::new(b, *i)).collect();
-        let (_, cb) = range_bounds(&refs);
-        let scale = Vec3A::splat(BINS as f32 * (1.0 - 1e-6)) / (cb.max - cb.min);
-        let mut one = [[EMPTY_BIN; BINS]; 3];
-        for r in refs.iter_mut() {
-            bin_ref(&mut one, r, cb.min, scale);
-        }
-        let two = bin_refs(&mut refs, cb.min, scale);
-        assert!(refs.len() >= TWO_BIN_SETS);
-        for (a, b) in one.iter().flatten().zip(two.iter().flatten()) {
-            assert_eq!(
-                (a.lo.to_array(), a.hi.to_array(), a.count),
-                (b.lo.to_array(), b.hi.to_array(), b.count)
-            );
-        }
     }
 
     #[test]

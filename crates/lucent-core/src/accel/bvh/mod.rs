@@ -16,11 +16,13 @@
 
 mod binary;
 mod box_test;
+mod build_ref;
 mod lanes;
 mod packet;
 mod ray_lanes;
 pub mod ray_packet;
 mod ray_triangle;
+mod sah_bins;
 mod traverse;
 mod wide;
 
@@ -101,7 +103,7 @@ impl Bvh {
     /// Builds for a given instruction set (tests use this to check every path).
     pub fn build_for<P: PrimitiveSet + ?Sized>(prims: &P, isa: Isa) -> Bvh {
         // The references in primitive order, their boxes computed on the pool's threads.
-        let mut refs: Vec<binary::BuildRef> = huge_pages::vec_with_capacity(prims.count());
+        let mut refs: Vec<build_ref::BuildRef> = huge_pages::vec_with_capacity(prims.count());
         {
             use rayon::prelude::*;
             // Indexed, so the references are written in place (a filtered parallel
@@ -109,7 +111,7 @@ impl Bvh {
             refs.par_extend(
                 (0..prims.count() as u32)
                     .into_par_iter()
-                    .map(|i| binary::BuildRef::new(&prims.bounds(i), i)),
+                    .map(|i| build_ref::BuildRef::new(&prims.bounds(i), i)),
             );
         }
         refs.retain(|r| super::is_bounded(&r.bounds()));
