@@ -24,7 +24,9 @@ pub enum Shape {
         p: [Vec3A; 3],
         normals: Option<u32>,
     },
-    Sphere(Sphere),
+    /// Boxed like `Analytic`: three transforms and a box, four times the size of a
+    /// triangle, which every primitive would otherwise carry (and bring into the cache).
+    Sphere(Box<Sphere>),
     /// Boxed: it is much larger than a triangle, and triangles should not pay for it.
     Analytic(Box<Analytic>),
     /// A whole triangle mesh (with its own structure), possibly shared.
@@ -227,6 +229,13 @@ impl PrimitiveSet for [Primitive] {
     fn occludes(&self, i: u32, ray: &PreparedRay, t_max: f32) -> bool {
         self[i as usize].occludes(ray, t_max)
     }
+
+    #[inline(always)]
+    fn prefetch(&self, i: u32) {
+        if let Some(p) = self.get(i as usize) {
+            crate::accel::prefetch_value(p);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -243,7 +252,7 @@ mod tests {
             * Affine3A::from_scale(glam::Vec3::new(2.0, 1.0, 1.0));
         let s = Sphere::new(m);
         assert!((s.bounds.max - Vec3A::new(1.0, 2.0, 1.0)).abs().max_element() < 1e-5);
-        let prim = Primitive::new(Shape::Sphere(s), 0);
+        let prim = Primitive::new(Shape::Sphere(Box::new(s)), 0);
         // A ray down the z axis at (x=0.5, y=0) hits the ellipsoid x² + (y/2)² + z² = 1 at z = sqrt(0.75).
         let ray = Ray::segment(Vec3A::new(0.5, 0.0, 5.0), -Vec3A::Z, 1e-4, f32::INFINITY);
         let t = prim.intersect(0, &PreparedRay::new(ray), f32::INFINITY).unwrap().t;
@@ -335,7 +344,7 @@ mod tests {
         let m = Affine3A::from_translation(glam::Vec3::new(1000.0, -700.0, 300.0))
             * Affine3A::from_rotation_y(0.3)
             * Affine3A::from_scale(glam::Vec3::new(3.0, 1.5, 2.0));
-        let prim = Primitive::new(Shape::Sphere(Sphere::new(m)), 0);
+        let prim = Primitive::new(Shape::Sphere(Box::new(Sphere::new(m))), 0);
         let (tried, bare, spawned) = refound(&prim, Vec3A::new(1000.0, -700.0, 300.0), 40.0, 5.0, 1e-3, false);
         assert!(tried > 5_000, "{tried}");
         assert_eq!(spawned, 0, "of {tried}");

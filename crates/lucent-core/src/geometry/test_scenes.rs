@@ -14,7 +14,7 @@ pub fn soup(seed: u64, n: usize) -> Vec<Primitive> {
             let shape = if i % 5 == 0 {
                 let m = Affine3A::from_translation(c.into())
                     * Affine3A::from_scale(Vec3::new(rng.range(0.1, 1.0), rng.range(0.1, 1.0), rng.range(0.1, 1.0)));
-                Shape::Sphere(Sphere::new(m))
+                Shape::Sphere(Box::new(Sphere::new(m)))
             } else {
                 Shape::Triangle {
                     p: [c + rng.vec(1.5), c + rng.vec(1.5), c + rng.vec(1.5)],

@@ -439,21 +439,21 @@ mod tests {
             // An ellipsoid, a sphere, a sheared cylinder, a cone, a disk, a box, a
             // triangle, and a sphere that does not emit.
             Primitive::new(
-                Shape::Sphere(Sphere::new(place(
+                Shape::Sphere(Box::new(Sphere::new(place(
                     Vec3::new(1.0, 0.4, 0.7),
                     Vec3::new(1.0, 1.0, 0.0),
                     0.7,
                     Vec3::new(-2.0, 0.0, 0.0),
-                ))),
+                )))),
                 1,
             ),
             Primitive::new(
-                Shape::Sphere(Sphere::new(place(
+                Shape::Sphere(Box::new(Sphere::new(place(
                     Vec3::splat(0.3),
                     Vec3::X,
                     0.0,
                     Vec3::new(0.0, 2.0, 0.5),
-                ))),
+                )))),
                 2,
             ),
             analytic(
@@ -495,12 +495,12 @@ mod tests {
                 1,
             ),
             Primitive::new(
-                Shape::Sphere(Sphere::new(place(
+                Shape::Sphere(Box::new(Sphere::new(place(
                     Vec3::splat(0.2),
                     Vec3::X,
                     0.0,
                     Vec3::new(0.0, 0.5, 0.0),
-                ))),
+                )))),
                 0,
             ),
         ]

@@ -91,7 +91,7 @@ fn shapes(
                 let Some(m) = single_precision(m, s.loc, name, diags) else {
                     continue;
                 };
-                Shape::Sphere(Sphere::new(m))
+                Shape::Sphere(Box::new(Sphere::new(m)))
             }
             ShapeKind::Plane { .. }
             | ShapeKind::Box { .. }

@@ -92,7 +92,7 @@ impl Packet {
                 lanes.v[lane] * lanes.inv_det[lane],
                 lanes.w[lane] * lanes.inv_det[lane],
             );
-            Self::record(Hit::new(t, self.ids[lane], b1, b2), t_max, best);
+            Self::record(prims, Hit::new(t, self.ids[lane], b1, b2), t_max, best);
         }
         for lane in Lanes(lanes.scalar) {
             let id = self.ids[lane];
@@ -103,7 +103,7 @@ impl Packet {
                     .map(|(t, b1, b2)| Hit::new(t, id, b1, b2))
             };
             if let Some(hit) = hit {
-                Self::record(hit, t_max, best);
+                Self::record(prims, hit, t_max, best);
             }
         }
     }
@@ -126,8 +126,9 @@ impl Packet {
     }
 
     #[inline(always)]
-    fn record(hit: Hit, t_max: &mut f32, best: &mut Option<Hit>) {
+    fn record<P: PrimitiveSet + ?Sized>(prims: &P, hit: Hit, t_max: &mut f32, best: &mut Option<Hit>) {
         if Hit::is_closer_than(hit.t, hit.prim, best) {
+            prims.prefetch(hit.prim);
             *best = Some(hit);
             *t_max = hit.t;
         }

@@ -512,6 +512,11 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                     let h = ray_triangle::test(packet, lane, sh, *t_max_lanes, active);
                     let (accept, scalar) = (h.accept, h.scalar);
                     if accept != 0 {
+                        if Q::SHRINKS {
+                            // A closest hit will be shaded: its data on the way (see
+                            // `PrimitiveSet::prefetch`).
+                            prims.prefetch(id);
+                        }
                         h.t.store(t.as_mut_ptr());
                         h.v.store(v.as_mut_ptr());
                         h.w.store(w.as_mut_ptr());
