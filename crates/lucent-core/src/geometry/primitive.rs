@@ -20,10 +20,7 @@ use glam::Vec2;
 pub enum Shape {
     /// World-space vertices; `normals` indexes the scene's per-vertex normals
     /// (`trinormal`), `None` for the flat geometric normal (`tri`).
-    Triangle {
-        p: [Vec3A; 3],
-        normals: Option<u32>,
-    },
+    Triangle { p: [Vec3A; 3], normals: Option<u32> },
     /// Boxed like `Analytic`: three transforms and a box, four times the size of a
     /// triangle, which every primitive would otherwise carry (and bring into the cache).
     Sphere(Box<Sphere>),
