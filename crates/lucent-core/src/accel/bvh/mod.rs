@@ -93,6 +93,9 @@ pub struct Bvh {
     nodes: Vec<WideNode>,
     packets: Vec<Packet>,
     isa: Isa,
+    /// More node levels than [`traverse::SHALLOW_LEVELS`]: queries take the paths with
+    /// the large stack.
+    deep: bool,
 }
 
 impl Bvh {
@@ -118,10 +121,14 @@ impl Bvh {
         let tree = binary::build_refs(refs);
         let wide = wide::collapse(&tree, prims);
         assert!(Isa::available().contains(&isa), "{isa:?} requested on a CPU without it");
+        let levels = wide::levels(&wide.nodes);
+        // The traversal stacks are sized by levels (the build bounds its depth).
+        assert!(levels <= traverse::MAX_LEVELS, "a BVH of {levels} levels");
         Bvh {
             nodes: wide.nodes,
             packets: wide.packets,
             isa,
+            deep: levels > traverse::SHALLOW_LEVELS,
         }
     }
 
@@ -215,9 +222,14 @@ trait Query<P: PrimitiveSet + ?Sized> {
     type Answer;
     const NONE: Self::Answer;
     /// # Safety
-    /// `T`'s instructions must be available, and `ZERO` set when the ray has a zero
-    /// direction component.
-    unsafe fn run<T: BoxTest, const ZERO: bool>(b: &Bvh, prims: &P, r: &PreparedRay, rb: &T::Ray) -> Self::Answer;
+    /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
+    /// direction component, and the tree at most `STACK / (WIDTH - 1)` levels deep.
+    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
+        b: &Bvh,
+        prims: &P,
+        r: &PreparedRay,
+        rb: &T::Ray,
+    ) -> Self::Answer;
 }
 
 struct Closest;
@@ -227,8 +239,13 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
     type Answer = Option<Hit>;
     const NONE: Option<Hit> = None;
     #[inline(always)]
-    unsafe fn run<T: BoxTest, const ZERO: bool>(b: &Bvh, prims: &P, r: &PreparedRay, rb: &T::Ray) -> Option<Hit> {
-        traverse::closest::<T, ZERO, P>(&b.nodes, &b.packets, prims, r, rb)
+    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
+        b: &Bvh,
+        prims: &P,
+        r: &PreparedRay,
+        rb: &T::Ray,
+    ) -> Option<Hit> {
+        traverse::closest::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
     }
 }
 
@@ -236,13 +253,20 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
     type Answer = bool;
     const NONE: bool = false;
     #[inline(always)]
-    unsafe fn run<T: BoxTest, const ZERO: bool>(b: &Bvh, prims: &P, r: &PreparedRay, rb: &T::Ray) -> bool {
-        traverse::occluded::<T, ZERO, P>(&b.nodes, &b.packets, prims, r, rb)
+    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
+        b: &Bvh,
+        prims: &P,
+        r: &PreparedRay,
+        rb: &T::Ray,
+    ) -> bool {
+        traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
     }
 }
 
+use traverse::{DEEP_STACK, SHALLOW_STACK};
+
 /// The AVX2 paths, compiled with AVX2 and FMA enabled: the fused box test for rays
-/// that have its constants, the plain one for the others.
+/// that have its constants, the plain one for the others. Shallow trees only.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
@@ -252,7 +276,7 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
     use lanes::Avx;
     let rb = RayBoxes::new(r);
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false>(b, prims, r, &Fused::prepare(&rb, &offsets))
+        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(b, prims, r, &Fused::prepare(&rb, &offsets))
     } else {
         run_avx2_plain::<Q, P>(b, prims, r, &rb)
     }
@@ -272,9 +296,45 @@ unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 ) -> Q::Answer {
     use lanes::Avx;
     if r.zero_axes.any() {
-        Q::run::<Slab<Avx>, true>(b, prims, r, &Slab::prepare(rb))
+        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(rb))
     } else {
-        Q::run::<Slab<Avx>, false>(b, prims, r, &Slab::prepare(rb))
+        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(rb))
+    }
+}
+
+/// The paths without AVX2, shallow trees only; out of line, so that their frames do not
+/// add to the AVX2 path's caller.
+#[inline(never)]
+unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+    let zero = r.zero_axes.any();
+    let rb = RayBoxes::new(r);
+    match b.isa {
+        #[cfg(target_arch = "x86_64")]
+        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 if zero => {
+            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
+        }
+        #[cfg(target_arch = "x86_64")]
+        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
+            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
+        }
+        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb)),
+        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb)),
+    }
+}
+
+/// Trees deeper than [`traverse::SHALLOW_LEVELS`] (only pathological inputs make them):
+/// the plain box test (it takes every ray; every box test enters the same boxes the
+/// answers depend on, so the answers are the same) with the large stack.
+#[cold]
+#[inline(never)]
+unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+    let rb = RayBoxes::new(r);
+    match b.isa {
+        #[cfg(target_arch = "x86_64")]
+        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
+            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb))
+        }
+        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb)),
     }
 }
 
@@ -284,22 +344,18 @@ impl Bvh {
         if self.nodes.is_empty() {
             return Q::NONE;
         }
-        let zero = r.zero_axes.any();
         // SAFETY: node and packet references were built by `wide::collapse` for these
-        // primitives; the AVX2 path is only taken when the CPU has AVX2 and FMA
-        // (`isa` checked at build); SSE2 is part of x86-64.
+        // primitives, with at most `MAX_LEVELS` levels (asserted at build) and at most
+        // `SHALLOW_LEVELS` unless `deep`; the AVX2 path is only taken when the CPU has
+        // AVX2 and FMA (`isa` checked at build); SSE2 is part of x86-64.
         unsafe {
+            if self.deep {
+                return run_deep::<Q, P>(self, prims, r);
+            }
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx512 | Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 if zero => {
-                    Q::run::<Slab<lanes::Sse>, true>(self, prims, r, &Slab::prepare(&RayBoxes::new(r)))
-                }
-                #[cfg(target_arch = "x86_64")]
-                Isa::Sse2 => Q::run::<Slab<lanes::Sse>, false>(self, prims, r, &Slab::prepare(&RayBoxes::new(r))),
-                _ if zero => Q::run::<Slab<f32>, true>(self, prims, r, &Slab::prepare(&RayBoxes::new(r))),
-                _ => Q::run::<Slab<f32>, false>(self, prims, r, &Slab::prepare(&RayBoxes::new(r))),
+                _ => run_portable::<Q, P>(self, prims, r),
             }
         }
     }
@@ -427,6 +483,44 @@ mod tests {
             found > 500 && found < prepared.len() - 500,
             "{found} hits: a test of both"
         );
+    }
+
+    #[test]
+    fn trees_know_their_levels_and_deep_trees_give_the_same_answers() {
+        use crate::accel::test_sets::Rng;
+        let few = Triangles::random(1, 6);
+        assert_eq!(wide::levels(&Bvh::build(&few).nodes), 1);
+        let prims = Triangles::random(4, 20_000);
+        let shallow = Bvh::build(&prims);
+        let levels = wide::levels(&shallow.nodes);
+        // 20,000 triangles in packets of four under nodes of eight: at least 5 levels
+        // (8⁴ · 4 < 20,000), and SAH trees are not much deeper.
+        assert!((5..=12).contains(&levels), "{levels} levels");
+        assert!(!shallow.deep);
+        // The same tree through the large-stack path every ISA has.
+        for isa in Isa::available() {
+            let mut deep = Bvh::build_for(&prims, isa);
+            deep.deep = true;
+            let mut rng = Rng(5);
+            for k in 0..3000 {
+                let o = rng.vec(15.0);
+                let mut d = rng.vec(1.0).normalize();
+                if k % 10 == 0 {
+                    d.x = 0.0; // a zero component: the slab test's other case
+                }
+                let r = PreparedRay::new(Ray::segment(o, d.normalize(), 1e-3, rng.range(1.0, 40.0)));
+                assert_eq!(
+                    deep.closest_hit(&prims, &r),
+                    shallow.closest_hit(&prims, &r),
+                    "{isa:?} ray {k}"
+                );
+                assert_eq!(
+                    deep.occluded(&prims, &r),
+                    shallow.occluded(&prims, &r),
+                    "{isa:?} ray {k}"
+                );
+            }
+        }
     }
 
     fn pool(threads: usize) -> rayon::ThreadPool {

@@ -15,8 +15,25 @@ use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
 use crate::ray::PreparedRay;
 
-/// Each visit pushes at most `WIDTH - 1` entries and the tree is at most ~100 levels deep.
-const STACK_SIZE: usize = (WIDTH - 1) * 112;
+/// The most node levels any tree has: the binary build's depth is bounded (object-median
+/// splits below depth 48 halve every node), and each wide level takes at least one
+/// binary level. [`super::Bvh`] asserts it at build time.
+pub const MAX_LEVELS: usize = 112;
+/// The node levels of the trees the fast paths are compiled for: every tree a real scene
+/// makes (a billion triangles in balanced nodes of eight need 10). Deeper trees take the
+/// paths with [`DEEP_STACK`].
+pub const SHALLOW_LEVELS: usize = 32;
+
+/// Stack entries for trees of `levels` node levels: each visit leaves at most
+/// `WIDTH - 1` entries for the levels below it.
+const fn stack_entries(levels: usize) -> usize {
+    (WIDTH - 1) * levels
+}
+/// The stack of the fast paths: 1.8 KB. A stack sized for [`MAX_LEVELS`] (6 KB) made
+/// every query's frame span two pages, behind a stack probe, and cost a miss-only query
+/// 40 % of its time.
+pub const SHALLOW_STACK: usize = stack_entries(SHALLOW_LEVELS);
+pub const DEEP_STACK: usize = stack_entries(MAX_LEVELS);
 
 /// Asks for the first cache lines of a child that was pushed on the stack: by the time
 /// it is popped, after the nearer subtree, they have arrived.
@@ -98,8 +115,13 @@ fn entry(dist: f32, reference: u32) -> u64 {
     (dist.to_bits() as u64) << 32 | reference as u64
 }
 
+/// The closest hit of `r` in the tree.
+///
+/// # Safety
+/// The nodes and packets must be one tree built for `prims`, of at most
+/// `STACK / (WIDTH - 1)` node levels, and `T`'s instructions available.
 #[inline(always)]
-pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
+pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize>(
     nodes: &[WideNode],
     packets: &[Packet],
     prims: &P,
@@ -110,7 +132,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     let mut t_max = r.ray.t_max;
     // Boxes are searched a little past the closest hit (ties); kept up to date with it.
     let mut limit = search_limit(t_max);
-    let mut stack = [const { MaybeUninit::<u64>::uninit() }; STACK_SIZE];
+    let mut stack = [const { MaybeUninit::<u64>::uninit() }; STACK];
     let mut sp = 0usize;
     let mut dist = [0.0f32; WIDTH];
     let mut cur = 0u32;
@@ -175,8 +197,9 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     }
 }
 
+/// Whether anything in the tree blocks `r` ([`closest`]'s conditions).
 #[inline(always)]
-pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
+pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize>(
     nodes: &[WideNode],
     packets: &[Packet],
     prims: &P,
@@ -184,7 +207,7 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized>(
     rb: &T::Ray,
 ) -> bool {
     let t_max = r.ray.t_max;
-    let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK_SIZE];
+    let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
     let mut sp = 0usize;
     let mut dist = [0.0f32; WIDTH];
     let mut cur = 0u32;

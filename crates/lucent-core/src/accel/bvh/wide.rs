@@ -52,6 +52,27 @@ pub struct WideTree {
     pub packets: Vec<Packet>,
 }
 
+/// How many node levels the tree has (a root whose children are all leaves: 1); what
+/// the traversal stack must hold.
+pub fn levels(nodes: &[WideNode]) -> usize {
+    if nodes.is_empty() {
+        return 0;
+    }
+    let mut deepest = 0;
+    // (byte offset of a node, its level)
+    let mut pending = vec![(0usize, 1usize)];
+    while let Some((offset, level)) = pending.pop() {
+        deepest = deepest.max(level);
+        let node = &nodes[offset / std::mem::size_of::<WideNode>()];
+        for &child in &node.child {
+            if child != EMPTY && child & LEAF == 0 {
+                pending.push((child as usize, level + 1));
+            }
+        }
+    }
+    deepest
+}
+
 pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
     let mut out = Collapse {
         nodes: crate::accel::huge_pages::vec_with_capacity(tree.nodes.len() / 4 + 1),
