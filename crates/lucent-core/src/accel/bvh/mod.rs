@@ -169,14 +169,15 @@ impl Bvh {
         for (k, chunk) in rays.chunks(width).enumerate() {
             let base = k * width;
             #[cfg(target_arch = "x86_64")]
-            if self.isa.has_avx2() && !self.nodes.is_empty() {
+            // (Trees deeper than the packets' stack trace their rays one by one.)
+            if self.isa.has_avx2() && !self.nodes.is_empty() && !self.deep {
                 let mut states = [Q::start(&chunk[0]); ray_packet::MAX_PACKET];
                 for (s, r) in states.iter_mut().zip(chunk) {
                     *s = Q::start(r);
                 }
                 let (nodes, packets, states) = (&self.nodes, &self.packets, &mut states[..chunk.len()]);
                 // SAFETY: `isa` was checked against the CPU when the tree was built for
-                // these primitives.
+                // these primitives, and the tree is not deep.
                 let alone = unsafe {
                     if self.isa == Isa::Avx512 {
                         ray_packet::traverse_avx512::<Q, P>(nodes, packets, prims, chunk, states)

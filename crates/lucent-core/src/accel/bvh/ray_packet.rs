@@ -32,9 +32,12 @@ use std::mem::MaybeUninit;
 
 /// The most rays a packet holds (AVX-512's sixteen lanes).
 pub const MAX_PACKET: usize = 16;
-// A visit pushes every entered child (up to `WIDTH`) and pops one: 7 more per level, and
-// the tree is at most ~100 levels deep.
-const STACK_SIZE: usize = WIDTH * 112;
+// A visit pushes every entered child (up to `WIDTH`) and pops one: fewer than `WIDTH`
+// more per level. Packets only walk trees of at most `SHALLOW_LEVELS` levels (deeper
+// ones trace their rays one by one, see `Bvh::in_packets`): sized for the 112 levels any
+// tree may have, the entry distances alone took 57 KB of stack, probed page by page on
+// every packet.
+const STACK_SIZE: usize = WIDTH * super::traverse::SHALLOW_LEVELS;
 /// A leaf reached by at least this many rays of a packet that shares its axes is tested
 /// triangle by triangle across the rays; by fewer, ray by ray (four triangles at a time).
 const LANE_LEAF_RAYS: u32 = 3;
@@ -302,7 +305,8 @@ impl Prepared<'_> {
 /// did not take (to be traced alone).
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA; `nodes` and `packets` must be a tree built for `prims`.
+/// The CPU must have AVX2 and FMA; `nodes` and `packets` must be a tree built for `prims`,
+/// of at most [`super::traverse::SHALLOW_LEVELS`] levels.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
@@ -320,7 +324,7 @@ pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
 ///
 /// # Safety
 /// The CPU must have AVX-512 F, VL and BW, AVX2 and FMA; `nodes` and `packets` must be a
-/// tree built for `prims`.
+/// tree built for `prims`, of at most [`super::traverse::SHALLOW_LEVELS`] levels.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 pub unsafe fn traverse_avx512<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
