@@ -41,6 +41,10 @@ pub struct Primitive {
     pub light: Option<u32>,
 }
 
+// Every triangle of a scene is one of these, and shading each hit reads one: keep the
+// large shapes boxed.
+const _: () = assert!(std::mem::size_of::<Primitive>() <= 80);
+
 impl Primitive {
     /// A primitive that does not emit light.
     pub fn new(shape: Shape, material: u32) -> Primitive {
