@@ -14,6 +14,7 @@
 
 pub mod emitters;
 pub mod environment;
+mod mapped_surface;
 
 use crate::math::{Color, Vec3A};
 use crate::shading::texture::EnvironmentMap;
