@@ -41,6 +41,7 @@ use super::{CameraHit, Integrator, TraceCounts};
 use crate::hit::{SurfacePoint, BACKGROUND};
 use crate::light::Light;
 use crate::math::{Color, Vec3A};
+use crate::pow;
 use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
@@ -120,21 +121,40 @@ impl Whitted {
             if let Light::Quad(q) = light {
                 let count = self.light_samples.max(1);
                 let mut shadows = ShadowBatch::new();
-                for k in 0..count {
-                    let (u, v) = t.sampler.uniform2();
-                    let (u, v) = if self.light_stratify {
-                        stratified(k, count, u, v)
-                    } else {
-                        (u, v)
-                    };
-                    let inc = q.incidence(sp.point, q.point(u, v));
-                    let reflected = diffuse * n.dot(inc.dir).max(0.0)
-                        + m.specular * n.dot((inc.dir + view).normalize()).max(0.0).powf(m.shininess);
-                    if reflected != Color::ZERO && inc.intensity != Color::ZERO {
-                        // Aimed at a point on the light: stops just before it.
-                        let shadow = sp.spawn_segment(inc.dir, inc.distance);
-                        shadows.add(scene, shadow, inc.intensity * reflected, t.counts);
+                // Up to sixteen samples at a time, so that their highlights are one
+                // vector computation (`crate::pow`).
+                let mut first = 0;
+                while first < count {
+                    let lanes = (count - first).min(pow::LANES as u32) as usize;
+                    let mut incs = [const { None }; pow::LANES];
+                    let mut cos_h = [0.0f32; pow::LANES];
+                    for (j, slot) in incs[..lanes].iter_mut().enumerate() {
+                        let (u, v) = t.sampler.uniform2();
+                        let (u, v) = if self.light_stratify {
+                            stratified(first + j as u32, count, u, v)
+                        } else {
+                            (u, v)
+                        };
+                        let inc = q.incidence(sp.point, q.point(u, v));
+                        cos_h[j] = n.dot((inc.dir + view).normalize()).max(0.0);
+                        *slot = Some(inc);
                     }
+                    // A material without a highlight needs no powers (each would be
+                    // multiplied by zero).
+                    let highlight = if m.specular == Color::ZERO {
+                        [0.0; pow::LANES]
+                    } else {
+                        pow::pow_lanes(&cos_h, m.shininess)
+                    };
+                    for (inc, &h) in incs[..lanes].iter().flatten().zip(&highlight) {
+                        let reflected = diffuse * n.dot(inc.dir).max(0.0) + m.specular * h;
+                        if reflected != Color::ZERO && inc.intensity != Color::ZERO {
+                            // Aimed at a point on the light: stops just before it.
+                            let shadow = sp.spawn_segment(inc.dir, inc.distance);
+                            shadows.add(scene, shadow, inc.intensity * reflected, t.counts);
+                        }
+                    }
+                    first += lanes as u32;
                 }
                 color += shadows.sum(scene) / count as f32;
                 continue;
@@ -142,7 +162,7 @@ impl Whitted {
             let inc = light.incidence(sp.point);
             let n_dot_l = n.dot(inc.dir).max(0.0);
             let n_dot_h = n.dot((inc.dir + view).normalize()).max(0.0);
-            let reflected = diffuse * n_dot_l + m.specular * n_dot_h.powf(m.shininess);
+            let reflected = diffuse * n_dot_l + m.specular * pow::pow(n_dot_h, m.shininess);
             // A light that could add nothing needs no shadow ray.
             if reflected == Color::ZERO || inc.intensity == Color::ZERO {
                 continue;
