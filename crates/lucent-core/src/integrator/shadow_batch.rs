@@ -4,8 +4,10 @@
 //! travel through the BVH in packets ([`Scene::occluded_rays`]); each unblocked
 //! sample's light is added in sample order, so the sum is the one a ray at a time gives.
 
+use std::mem::MaybeUninit;
+
 use super::TraceCounts;
-use crate::math::{Color, Vec3A};
+use crate::math::Color;
 use crate::ray::Ray;
 use crate::scene::Scene;
 
@@ -13,9 +15,12 @@ use crate::scene::Scene;
 const BATCH: usize = 64;
 
 pub struct ShadowBatch {
-    rays: [Ray; BATCH],
-    /// What each ray's sample adds when nothing blocks it.
-    lit: [Color; BATCH],
+    /// The first `made` are written. Left uninitialised until then: a batch is made for
+    /// every shading point and light, and filling (then moving) its 4 KB cost more than
+    /// the few rays most batches hold.
+    rays: [MaybeUninit<Ray>; BATCH],
+    /// What each ray's sample adds when nothing blocks it (the first `made` are written).
+    lit: [MaybeUninit<Color>; BATCH],
     made: usize,
     sum: Color,
 }
@@ -23,8 +28,8 @@ pub struct ShadowBatch {
 impl ShadowBatch {
     pub fn new() -> ShadowBatch {
         ShadowBatch {
-            rays: [Ray::new(Vec3A::ZERO, Vec3A::Z); BATCH],
-            lit: [Color::ZERO; BATCH],
+            rays: [const { MaybeUninit::uninit() }; BATCH],
+            lit: [const { MaybeUninit::uninit() }; BATCH],
             made: 0,
             sum: Color::ZERO,
         }
@@ -35,8 +40,8 @@ impl ShadowBatch {
     #[inline]
     pub fn add(&mut self, scene: &Scene, ray: Ray, lit: Color, counts: &mut TraceCounts) {
         counts.rays += 1;
-        self.rays[self.made] = ray;
-        self.lit[self.made] = lit;
+        self.rays[self.made].write(ray);
+        self.lit[self.made].write(lit);
         self.made += 1;
         if self.made == BATCH {
             self.trace(scene);
@@ -44,7 +49,7 @@ impl ShadowBatch {
     }
 
     /// The sum of the unblocked samples' light, in sample order.
-    pub fn sum(mut self, scene: &Scene) -> Color {
+    pub fn sum(&mut self, scene: &Scene) -> Color {
         self.trace(scene);
         self.sum
     }
@@ -53,9 +58,16 @@ impl ShadowBatch {
         if self.made == 0 {
             return;
         }
+        // SAFETY: entries `..made` were written by `add` (MaybeUninit<T> has T's layout).
+        let (rays, lit) = unsafe {
+            (
+                std::slice::from_raw_parts(self.rays.as_ptr().cast::<Ray>(), self.made),
+                std::slice::from_raw_parts(self.lit.as_ptr().cast::<Color>(), self.made),
+            )
+        };
         let mut blocked = [false; BATCH];
-        scene.occluded_rays(&self.rays[..self.made], &mut blocked[..self.made]);
-        for (&lit, &b) in self.lit[..self.made].iter().zip(&blocked) {
+        scene.occluded_rays(rays, &mut blocked[..self.made]);
+        for (&lit, &b) in lit.iter().zip(&blocked) {
             if !b {
                 self.sum += lit;
             }
