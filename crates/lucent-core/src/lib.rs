@@ -10,7 +10,7 @@
 //!
 //! | floor | modules |
 //! |---|---|
-//! | 0 base | [`math`], [`pow`], [`transform`], [`ray`], [`aabb`], [`hit`], [`spawn`], [`sampler`], [`sampling`] |
+//! | 0 base | [`math`], [`pow`], [`huge_pages`], [`transform`], [`ray`], [`aabb`], [`hit`], [`spawn`], [`sampler`], [`sampling`] |
 //! | 1 shapes | [`shape`]: intersection routines, texture coordinates, tangents |
 //! | 2 acceleration | [`accel`]: structures over any [`accel::PrimitiveSet`] |
 //! | 3 geometry | [`geometry`]: primitives, meshes, instances, the primitive set |
@@ -25,6 +25,7 @@
 
 pub mod aabb;
 pub mod hit;
+pub mod huge_pages;
 pub mod math;
 pub mod pow;
 pub mod ray;

@@ -16,6 +16,7 @@ type Floors = &'static [(&'static str, u32)];
 const CORE: Floors = &[
     ("math", 0),
     ("pow", 0),
+    ("huge_pages", 0),
     ("transform", 0),
     ("ray", 0),
     ("aabb", 0),

@@ -9,7 +9,6 @@
 pub mod bvh;
 mod cell_walk;
 pub mod grid;
-mod huge_pages;
 pub mod kdtree;
 pub mod list;
 mod mailbox;

@@ -43,9 +43,9 @@ impl Film {
         Film {
             width,
             height,
-            sums: vec![ExactSum::default(); n],
+            sums: crate::huge_pages::vec_filled(n, ExactSum::default()),
             counts: vec![0; n],
-            aovs: aovs.then(|| vec![AovSum::default(); n]),
+            aovs: aovs.then(|| crate::huge_pages::vec_filled(n, AovSum::default())),
             noise: None,
         }
     }

@@ -71,7 +71,7 @@ pub fn build_refs(refs: Vec<BuildRef>) -> BinaryTree {
     let mut tree = BinaryTree {
         // About two nodes for every three references (leaves hold three on average);
         // pages never written are never touched.
-        nodes: crate::accel::huge_pages::vec_with_capacity(refs.len() + 1),
+        nodes: crate::huge_pages::vec_with_capacity(refs.len() + 1),
         refs,
     };
     if !tree.refs.is_empty() {

@@ -26,8 +26,9 @@ mod sah_bins;
 mod traverse;
 mod wide;
 
-use super::{huge_pages, Accelerator, PrimitiveSet};
+use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
+use crate::huge_pages;
 use crate::ray::{PreparedRay, Ray};
 use box_test::{BoxTest, FmaOffsets, RayBoxes, Slab};
 use packet::Packet;

@@ -75,7 +75,7 @@ pub fn levels(nodes: &[WideNode]) -> usize {
 
 pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
     let mut out = Collapse {
-        nodes: crate::accel::huge_pages::vec_with_capacity(tree.nodes.len() / 4 + 1),
+        nodes: crate::huge_pages::vec_with_capacity(tree.nodes.len() / 4 + 1),
         packet_refs: Vec::with_capacity(prims.count() / 3 + 1),
     };
     if let Some(root) = tree.nodes.first() {
@@ -94,7 +94,7 @@ pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideT
     // The packets' corners are gathered from the primitives (scattered reads, most of
     // the collapse's time) on the pool's threads, each written in its place: the same
     // packets for any number of threads.
-    let mut packets = crate::accel::huge_pages::vec_with_capacity(out.packet_refs.len());
+    let mut packets = crate::huge_pages::vec_with_capacity(out.packet_refs.len());
     {
         use rayon::prelude::*;
         packets.par_extend(out.packet_refs.par_iter().map(|&(start, count)| {
