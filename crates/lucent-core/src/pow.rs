@@ -96,8 +96,9 @@ fn pow_one(x: f32, y: f64) -> f32 {
     let t = (y * log2_x).clamp(-160.0, 130.0);
     let shifted = t + ROUND_MAGIC;
     let n = shifted.to_bits().wrapping_sub(ROUND_MAGIC.to_bits()) as i64;
-    let f = t - (shifted - ROUND_MAGIC); // in [−½, ½], exact
-                                         // 2^f = e^g, g = f ln 2 in [−0.347, 0.347]: Taylor to degree 11, error below 1e-14.
+    // f = t − n, in [−½, ½] and exact.
+    let f = t - (shifted - ROUND_MAGIC);
+    // 2^f = e^g, g = f ln 2 in [−0.347, 0.347]: Taylor to degree 11, error below 1e-14.
     let g = f * std::f64::consts::LN_2;
     let p = 1.0
         + g * (1.0
