@@ -15,17 +15,13 @@
 //! instruction set gives the same bits.
 //!
 //! Domain: `x` finite and `≥ 0`, `y ≥ 0` (what `shininess` allows); `0^0 = 1`.
+//!
+//! There is no one-at-a-time version: for a single power libm's `powf` is faster, since
+//! this is one long dependency chain (a division, then polynomials of 7 and 11 steps)
+//! that pays only when sixteen run side by side.
 
 /// How many powers [`pow_lanes`] computes at once.
 pub const LANES: usize = 16;
-
-/// `x^y` for one `x` (the same arithmetic as [`pow_lanes`], without vectors). For a
-/// single power libm's `powf` is faster: this is one long dependency chain (a division,
-/// then two polynomials of 7 and 11 steps), which pays only when sixteen run side by side.
-#[inline]
-pub fn pow(x: f32, y: f32) -> f32 {
-    pow_one(x, y.min(f32::MAX) as f64)
-}
 
 /// `x[i]^y` for all sixteen lanes.
 #[inline]
@@ -128,6 +124,11 @@ fn pow_one(x: f32, y: f64) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One lane of [`pow_lanes`].
+    fn pow(x: f32, y: f32) -> f32 {
+        pow_one(x, y.min(f32::MAX) as f64)
+    }
 
     /// The correctly rounded `x^y` (as `f64`, whose own error is far below an f32 ulp).
     fn exact(x: f32, y: f32) -> f32 {

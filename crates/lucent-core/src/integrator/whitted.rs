@@ -162,8 +162,8 @@ impl Whitted {
             let inc = light.incidence(sp.point);
             let n_dot_l = n.dot(inc.dir).max(0.0);
             let n_dot_h = n.dot((inc.dir + view).normalize()).max(0.0);
-            // One power: libm's `powf` (short polynomials on tables) is faster than
-            // `pow::pow`, whose long dependency chain only pays sixteen lanes at a time.
+            // One power: libm's `powf` (short polynomials on tables) is faster here than
+            // `pow`'s long dependency chain, which only pays sixteen lanes at a time.
             let reflected = diffuse * n_dot_l + m.specular * n_dot_h.powf(m.shininess);
             // A light that could add nothing needs no shadow ray.
             if reflected == Color::ZERO || inc.intensity == Color::ZERO {
