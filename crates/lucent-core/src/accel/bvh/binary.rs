@@ -87,17 +87,25 @@ pub fn build_refs(refs: Vec<BuildRef>) -> BinaryTree {
             // copy the nodes over and over.
             let parallel = PARALLEL_REFS.max(tree.refs.len() / (8 * threads));
             let parts = build_subtree(&mut tree.refs, 0, b, c, 0, parallel);
-            // Each part moves into place once, its child indices rebased.
-            for part in parts {
-                let base = tree.nodes.len() as u32;
-                tree.nodes.extend(part.into_iter().map(|mut n| {
-                    if let Kind::Interior { left, right } = &mut n.kind {
-                        *left += base;
-                        *right += base;
-                    }
-                    n
-                }));
+            // Each part moves into place once, its child indices rebased, on the pool's
+            // threads.
+            let mut bases = Vec::with_capacity(parts.len());
+            let mut total = 0;
+            for part in &parts {
+                bases.push(total);
+                total += part.len();
             }
+            use rayon::prelude::*;
+            tree.nodes.par_extend((0..total).into_par_iter().map(|i| {
+                // The last part that begins at or before node i.
+                let k = bases.partition_point(|&b| b <= i) - 1;
+                let mut n = parts[k][i - bases[k]];
+                if let Kind::Interior { left, right } = &mut n.kind {
+                    *left += bases[k] as u32;
+                    *right += bases[k] as u32;
+                }
+                n
+            }));
         }
     }
     tree

@@ -6,8 +6,9 @@
 //! becomes one leaf (of at most two packets) instead of a node. The node stores its
 //! children's boxes as structure-of-arrays, so one AVX instruction (or two SSE ones)
 //! tests all eight. Leaves become runs of four-wide packets, laid out in the order
-//! traversal meets them; the nodes are laid out on one thread, then the packets are
-//! filled on the pool's threads.
+//! traversal meets them. With more than one thread, large subtrees are laid out by
+//! tasks of their own, each as parts in the one-thread order, put together at the end;
+//! the packets are filled on the pool's threads: the same tree for any number of threads.
 
 use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
 use super::packet::{Packet, LANES};
@@ -74,30 +75,41 @@ pub fn levels(nodes: &[WideNode]) -> usize {
 }
 
 pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
-    let mut out = Collapse {
-        nodes: crate::huge_pages::vec_with_capacity(tree.nodes.len() / 4 + 1),
-        packet_refs: Vec::with_capacity(prims.count() / 3 + 1),
-    };
-    if let Some(root) = tree.nodes.first() {
-        match root.kind {
-            // A lone leaf still gets a node above it: traversal starts at a node.
-            Kind::Leaf { .. } => {
-                out.nodes.push(WideNode::EMPTY);
-                let slot = leaf_slot(root, &mut out);
-                set_child(&mut out.nodes[0], 0, root, slot);
-            }
-            Kind::Interior { .. } => {
-                collapse_node(tree, 0, &mut out);
-            }
+    let threads = rayon::current_num_threads();
+    let parts = match tree.nodes.first() {
+        None => vec![],
+        // A lone leaf still gets a node above it: traversal starts at a node.
+        Some(
+            root @ BinaryNode {
+                kind: Kind::Leaf { .. },
+                ..
+            },
+        ) => {
+            let mut part = Part::with_capacity(1, 1);
+            part.nodes.push(WideNode::EMPTY);
+            let slot = leaf_slot(root, &mut part);
+            set_child(&mut part.nodes[0], 0, root, slot);
+            vec![part]
         }
-    }
+        Some(_) if threads == 1 => {
+            let mut part = Part::with_capacity(tree.nodes.len() / 4 + 1, tree.refs.len() / 3 + 1);
+            collapse_node(tree, 0, &mut part);
+            vec![part]
+        }
+        Some(_) => {
+            // Enough tasks to keep every thread busy, few enough that parts stay large.
+            let parallel = PARALLEL_REFS.max(tree.refs.len() / (8 * threads));
+            collapse_parallel(tree, 0, parallel)
+        }
+    };
+    let (nodes, packet_refs) = join_parts(parts);
     // The packets' corners are gathered from the primitives (scattered reads, most of
     // the collapse's time) on the pool's threads, each written in its place: the same
     // packets for any number of threads.
-    let mut packets = crate::huge_pages::vec_with_capacity(out.packet_refs.len());
+    let mut packets = crate::huge_pages::vec_with_capacity(packet_refs.len());
     {
         use rayon::prelude::*;
-        packets.par_extend(out.packet_refs.par_iter().map(|&(start, count)| {
+        packets.par_extend(packet_refs.par_iter().map(|&(start, count)| {
             let mut ids = [0u32; LANES];
             let chunk = &tree.refs[start as usize..(start + count) as usize];
             for (id, r) in ids.iter_mut().zip(chunk) {
@@ -106,17 +118,181 @@ pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideT
             Packet::new(prims, &ids[..chunk.len()])
         }));
     }
-    WideTree {
-        nodes: out.nodes,
-        packets,
+    WideTree { nodes, packets }
+}
+
+/// With more than one thread, subtrees of more than this many references (more for
+/// large trees: see [`collapse`]) are collapsed with a parallel task for each large child.
+const PARALLEL_REFS: usize = 4096;
+
+/// A run of the wide tree in the one-thread order, laid out on its own: its nodes and,
+/// for each packet, the references it will hold (`tree.refs[start..start + count]`).
+/// Its interior references count (in bytes) from its first node, its leaf references
+/// from its first packet; [`join_parts`] moves them to their places.
+struct Part {
+    nodes: Vec<WideNode>,
+    packet_refs: Vec<(u32, u32)>,
+}
+
+impl Part {
+    fn with_capacity(nodes: usize, packets: usize) -> Part {
+        Part {
+            nodes: crate::huge_pages::vec_with_capacity(nodes),
+            packet_refs: Vec::with_capacity(packets),
+        }
     }
 }
 
-/// The wide tree as the collapse lays it out: its nodes, and for each packet the
-/// references it will hold (`tree.refs[start..start + count]`).
-struct Collapse {
-    nodes: Vec<WideNode>,
-    packet_refs: Vec<(u32, u32)>,
+/// How many references the subtree under binary node `n` holds (they are contiguous:
+/// from its leftmost leaf's first to its rightmost leaf's last).
+fn subtree_refs(tree: &BinaryTree, n: u32) -> usize {
+    let (mut first, mut last) = (n, n);
+    while let Kind::Interior { left, .. } = tree.nodes[first as usize].kind {
+        first = left;
+    }
+    while let Kind::Interior { right, .. } = tree.nodes[last as usize].kind {
+        last = right;
+    }
+    match (tree.nodes[first as usize].kind, tree.nodes[last as usize].kind) {
+        (Kind::Leaf { start, .. }, Kind::Leaf { start: s, count }) => (s + count - start) as usize,
+        _ => unreachable!("leaves"),
+    }
+}
+
+/// The wide subtree standing for interior binary node `b` as consecutive parts: the
+/// nodes and packets of [`collapse_node`], in its order, with large child subtrees
+/// collapsed on the pool's threads.
+fn collapse_parallel(tree: &BinaryTree, b: u32, parallel: usize) -> Vec<Part> {
+    let refs = subtree_refs(tree, b);
+    if refs <= parallel {
+        // About one node for every six references, one packet for every three.
+        let mut part = Part::with_capacity(refs / 6 + 1, refs / 3 + 1);
+        collapse_node(tree, b, &mut part);
+        return vec![part];
+    }
+    let (children, count) = open_children(tree, b);
+    let children = &children[..count];
+    let leaves: Vec<Option<(u32, u32)>> = children.iter().map(|&c| leaf_refs(tree, c)).collect();
+    let subtrees: Vec<Vec<Part>> = {
+        use rayon::prelude::*;
+        let interior: Vec<u32> = (children.iter().zip(&leaves))
+            .filter_map(|(&c, leaf)| leaf.is_none().then_some(c))
+            .collect();
+        interior
+            .par_iter()
+            .map(|&c| collapse_parallel(tree, c, parallel))
+            .collect()
+    };
+    let mut subtrees = subtrees.into_iter();
+    // This node first, then its children in slot order: a leaf child's packets where
+    // `collapse_node` puts them, between the parts of the subtrees.
+    let mut parts = vec![Part {
+        nodes: vec![WideNode::EMPTY],
+        packet_refs: Vec::new(),
+    }];
+    let mut node = WideNode::EMPTY;
+    // Nodes and packets laid out since this node's part began.
+    let (mut nodes_before, mut packets_before) = (1usize, 0usize);
+    for (slot, (&c, leaf)) in children.iter().zip(&leaves).enumerate() {
+        let reference = match *leaf {
+            Some((start, count)) => {
+                let last = parts.last_mut().expect("this node's part");
+                let first = packets_before + last.packet_refs.len();
+                push_packets(start, count, first, &mut last.packet_refs)
+            }
+            None => {
+                if let Some(last) = parts.last() {
+                    packets_before += last.packet_refs.len();
+                }
+                let offset = byte_offset(nodes_before);
+                for part in subtrees.next().expect("a subtree for each interior child") {
+                    nodes_before += part.nodes.len();
+                    packets_before += part.packet_refs.len();
+                    parts.push(part);
+                }
+                // For the packets of the leaf children that follow.
+                parts.push(Part {
+                    nodes: Vec::new(),
+                    packet_refs: Vec::new(),
+                });
+                offset
+            }
+        };
+        set_child(&mut node, slot, &tree.nodes[c as usize], reference);
+    }
+    parts[0].nodes[0] = node;
+    parts
+}
+
+/// The parts put together: each part's references moved by the nodes and packets before
+/// it, the nodes written in place on the pool's threads.
+fn join_parts(mut parts: Vec<Part>) -> (Vec<WideNode>, Vec<(u32, u32)>) {
+    if parts.len() <= 1 {
+        return parts.pop().map_or_else(Default::default, |p| (p.nodes, p.packet_refs));
+    }
+    // Each part's first node and first packet in the whole tree.
+    let mut node_base = Vec::with_capacity(parts.len());
+    let mut packet_base = Vec::with_capacity(parts.len());
+    let (mut nodes, mut packets) = (0usize, 0usize);
+    for part in &parts {
+        node_base.push(nodes);
+        packet_base.push(packets);
+        nodes += part.nodes.len();
+        packets += part.packet_refs.len();
+    }
+    let mut out = crate::huge_pages::vec_with_capacity(nodes);
+    {
+        use rayon::prelude::*;
+        out.par_extend((0..nodes).into_par_iter().map(|i| {
+            // The last part that begins at or before node i (an empty part begins where
+            // the next one does).
+            let k = node_base.partition_point(|&b| b <= i) - 1;
+            let mut node = parts[k].nodes[i - node_base[k]];
+            for c in &mut node.child {
+                *c = relocate(*c, node_base[k], packet_base[k]);
+            }
+            node
+        }));
+    }
+    let mut packet_refs = Vec::with_capacity(packets);
+    for part in &parts {
+        packet_refs.extend_from_slice(&part.packet_refs);
+    }
+    (out, packet_refs)
+}
+
+/// A child reference of a part whose first node and first packet are `node_base` and
+/// `packet_base` of the whole tree, as the whole tree's reference.
+fn relocate(c: u32, node_base: usize, packet_base: usize) -> u32 {
+    if c == EMPTY {
+        EMPTY
+    } else if c & LEAF != 0 {
+        let first = (c & FIRST_MASK) as usize + packet_base;
+        (c & !FIRST_MASK) | checked_first(first)
+    } else {
+        byte_offset(c as usize / std::mem::size_of::<WideNode>() + node_base)
+    }
+}
+
+/// A packet index as a leaf reference holds it.
+fn checked_first(first: usize) -> u32 {
+    assert!(
+        first <= FIRST_MASK as usize,
+        "too many primitives for the BVH's 28-bit packet index"
+    );
+    first as u32
+}
+
+/// The reference to the node at `index`: interior children are referenced by byte
+/// offset, so traversal needs no multiplication between loading a reference and
+/// loading the node.
+fn byte_offset(index: usize) -> u32 {
+    let offset = index * std::mem::size_of::<WideNode>();
+    assert!(
+        offset < LEAF as usize,
+        "too many nodes for the BVH's 31-bit node offsets"
+    );
+    offset as u32
 }
 
 fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u32) {
@@ -148,33 +324,45 @@ fn small_subtree(tree: &BinaryTree, n: u32) -> Option<(u32, u32)> {
     }
 }
 
+/// The references `refs[start..start + count]` as packets appended to `packet_refs`,
+/// the first of them packet `first` of its part; returns the leaf's slot reference.
+fn push_packets(start: u32, count: u32, first: usize, packet_refs: &mut Vec<(u32, u32)>) -> u32 {
+    for k in (0..count).step_by(LANES) {
+        packet_refs.push((start + k, (count - k).min(LANES as u32)));
+    }
+    let n = count.div_ceil(LANES as u32);
+    LEAF | (n - 1) << PACKET_SHIFT | checked_first(first)
+}
+
 /// Lays out the packets of a binary leaf; returns its slot reference.
-fn leaf_slot(leaf: &BinaryNode, out: &mut Collapse) -> u32 {
+fn leaf_slot(leaf: &BinaryNode, out: &mut Part) -> u32 {
     let Kind::Leaf { start, count } = leaf.kind else {
         unreachable!("a leaf")
     };
-    let first = out.packet_refs.len() as u32;
-    for k in (0..count).step_by(LANES) {
-        out.packet_refs.push((start + k, (count - k).min(LANES as u32)));
-    }
-    let n = out.packet_refs.len() as u32 - first;
-    assert!(
-        first <= FIRST_MASK,
-        "too many primitives for the BVH's 28-bit packet index"
-    );
-    LEAF | (n - 1) << PACKET_SHIFT | first
+    push_packets(start, count, out.packet_refs.len(), &mut out.packet_refs)
 }
 
-/// Builds the wide node standing for interior binary node `b`; returns its index.
-fn collapse_node(tree: &BinaryTree, b: u32, out: &mut Collapse) -> u32 {
+/// The references of child `c` if it becomes a leaf: a binary leaf, or a small subtree
+/// merged into one.
+fn leaf_refs(tree: &BinaryTree, c: u32) -> Option<(u32, u32)> {
+    match tree.nodes[c as usize].kind {
+        Kind::Leaf { start, count } => Some((start, count)),
+        Kind::Interior { .. } => small_subtree(tree, c),
+    }
+}
+
+/// The children of the wide node standing for interior binary node `b` (and how many):
+/// its two children, then, while there are fewer than eight, the interior child with
+/// the largest surface area opened into its two.
+fn open_children(tree: &BinaryTree, b: u32) -> ([u32; WIDTH], usize) {
     let Kind::Interior { left, right } = tree.nodes[b as usize].kind else {
         unreachable!("interior")
     };
-    let mut children = Vec::with_capacity(WIDTH);
-    children.extend([left, right]);
-    while children.len() < WIDTH {
-        // Open the interior child with the largest surface area.
-        let widest = children
+    let mut children = [0u32; WIDTH];
+    (children[0], children[1]) = (left, right);
+    let mut count = 2;
+    while count < WIDTH {
+        let widest = children[..count]
             .iter()
             .enumerate()
             .filter(|(_, &c)| matches!(tree.nodes[c as usize].kind, Kind::Interior { .. }))
@@ -187,34 +375,25 @@ fn collapse_node(tree: &BinaryTree, b: u32, out: &mut Collapse) -> u32 {
         let Kind::Interior { left, right } = tree.nodes[children[i] as usize].kind else {
             unreachable!()
         };
-        children[i] = left;
-        children.insert(i + 1, right);
+        children.copy_within(i + 1..count, i + 2);
+        (children[i], children[i + 1]) = (left, right);
+        count += 1;
     }
+    (children, count)
+}
+
+/// Builds the wide node standing for interior binary node `b`, its subtree after it;
+/// returns its index.
+fn collapse_node(tree: &BinaryTree, b: u32, out: &mut Part) -> u32 {
+    let (children, count) = open_children(tree, b);
     let me = out.nodes.len();
     out.nodes.push(WideNode::EMPTY);
-    for (slot, &c) in children.iter().enumerate() {
-        let child = &tree.nodes[c as usize];
-        let reference = match child.kind {
-            Kind::Leaf { .. } => leaf_slot(child, out),
-            Kind::Interior { .. } if let Some((start, count)) = small_subtree(tree, c) => {
-                let merged = BinaryNode {
-                    bounds: child.bounds,
-                    kind: Kind::Leaf { start, count },
-                };
-                leaf_slot(&merged, out)
-            }
-            Kind::Interior { .. } => {
-                // Interior children are referenced by byte offset: traversal then needs
-                // no multiplication between loading a reference and loading the node.
-                let offset = collapse_node(tree, c, out) as usize * std::mem::size_of::<WideNode>();
-                assert!(
-                    offset < LEAF as usize,
-                    "too many nodes for the BVH's 31-bit node offsets"
-                );
-                offset as u32
-            }
+    for (slot, &c) in children[..count].iter().enumerate() {
+        let reference = match leaf_refs(tree, c) {
+            Some((start, n)) => push_packets(start, n, out.packet_refs.len(), &mut out.packet_refs),
+            None => byte_offset(collapse_node(tree, c, out) as usize),
         };
-        set_child(&mut out.nodes[me], slot, child, reference);
+        set_child(&mut out.nodes[me], slot, &tree.nodes[c as usize], reference);
     }
     me as u32
 }
