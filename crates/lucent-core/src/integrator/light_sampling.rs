@@ -88,18 +88,22 @@ pub fn one_light_mis(
     if count == 0 {
         return Color::ZERO;
     }
-    // A number to choose the light (and its piece) only where there is a choice.
-    let pick = if count > 1 || scene.sampled_light(0).has_pieces() {
+    // A number to choose a piece of the emissive surfaces, in a scene that has them.
+    let piece = if scene.emitters.is_some() {
         sampler.uniform()
     } else {
         0.0
     };
     let (u, v) = sampler.uniform2();
-    let scaled = pick * count as f32;
+    // The light is chosen by `u`, and what is left of `u` within the chosen light is the
+    // point's first number (as Mitsuba does): the samples of a pixel that go to one light
+    // are then spread over it as evenly as all of them are over the unit square. A number
+    // of its own for the choice gave each light a random subset of them: 8 % more error
+    // per sample on the dragon's two lights at 8 spp.
+    let scaled = u * count as f32;
     let index = (scaled as usize).min(count - 1);
-    // What is left of `pick` within the chosen light chooses its piece.
-    let rest = (scaled - index as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-    let Some(mut s) = scene.sampled_light(index).sample_li(x.point, rest, u, v) else {
+    let u = (scaled - index as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+    let Some(mut s) = scene.sampled_light(index).sample_li(x.point, piece, u, v) else {
         return Color::ZERO;
     };
     // The density of choosing this light and this point on it.
