@@ -96,11 +96,6 @@ impl PathTracer {
     /// below the surface: by the shading normal or by the true surface at `x`).
     fn bounce(&self, x: &SurfacePoint, bsdf: &Bsdf, wo: Vec3A, sampler: &mut Sampler) -> Option<Bounce> {
         let n = bsdf.normal();
-        // A number to choose the lobe only where there is a choice.
-        let pick = match self.sampling {
-            DirectionSampling::Brdf if !bsdf.has_one_lobe() => sampler.uniform(),
-            _ => 0.0,
-        };
         let (u, v) = sampler.uniform2();
         let (wi, f, pdf) = match self.sampling {
             DirectionSampling::Hemisphere => {
@@ -112,7 +107,7 @@ impl PathTracer {
                 (wi, bsdf.eval(wo, wi), warp::cosine_hemisphere_pdf(n.dot(wi)))
             }
             DirectionSampling::Brdf => {
-                let s = bsdf.sample(wo, pick, u, v)?;
+                let s = bsdf.sample_reusing(wo, u, v)?;
                 (s.wi, s.f, s.pdf)
             }
         };

@@ -116,15 +116,26 @@ impl Bsdf {
         }
     }
 
-    /// Whether [`Bsdf::sample`] has only one lobe to draw from, so that its `pick` does
-    /// not matter (0 picks that lobe): the path tracer then draws no number for it.
+    /// [`Bsdf::sample`] from two numbers (the path tracer's `importancesampling brdf`):
+    /// `u` chooses the lobe (the specular one below its share) and what is left of `u`
+    /// within the chosen lobe's share is the direction's first number. A pixel's samples
+    /// that choose one lobe are then spread over it as evenly as all of them are over the
+    /// square, where a number of its own for the choice gave each lobe a random subset
+    /// (as with the light choice of [`crate::integrator::light_sampling::one_light_mis`]).
+    /// With one lobe, `u` is used as it is.
     #[inline]
-    pub fn has_one_lobe(&self) -> bool {
-        match self {
-            Bsdf::Phong(b) => matches!(b.specular_share(), 0.0 | 1.0),
-            Bsdf::Ggx(b) => b.specular_share() == 1.0,
-            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => true,
-        }
+    pub fn sample_reusing(&self, wo: Vec3A, u: f32, v: f32) -> Option<BsdfSample> {
+        let share = match self {
+            Bsdf::Phong(b) => b.specular_share(),
+            Bsdf::Ggx(b) => b.specular_share(),
+            Bsdf::Mirror(_) | Bsdf::Dielectric(_) => return None,
+        };
+        let rest = if u < share {
+            u / share
+        } else {
+            (u - share) / (1.0 - share)
+        };
+        self.sample(wo, u, rest.clamp(0.0, 1.0 - f32::EPSILON / 2.0), v)
     }
 
     /// A direction drawn in proportion to the BSDF (`importancesampling brdf`): `pick`
@@ -171,5 +182,77 @@ pub(crate) mod test_support {
     pub fn pick(i: &mut u32) -> f32 {
         *i += 1;
         Sampler::new(0x91c4, *i, 1, 0).uniform()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::normal_and_views;
+    use super::*;
+    use crate::sampling::chi2::chi2_test;
+
+    #[test]
+    fn sampling_with_the_lobe_chosen_by_the_first_number_follows_the_mixture_density() {
+        // The same densities as `Bsdf::sample` with a number of its own for the lobe: χ²
+        // against the mixture's pdf, for Phong and GGX mixtures and single lobes.
+        let (n, views) = normal_and_views();
+        let c = Color::splat;
+        let bsdfs = [
+            Bsdf::Phong(phong::Phong {
+                n,
+                kd: c(0.5),
+                ks: c(0.3),
+                shininess: 5.0,
+            }),
+            Bsdf::Phong(phong::Phong {
+                n,
+                kd: c(0.1),
+                ks: c(0.5),
+                shininess: 1000.0,
+            }),
+            Bsdf::Phong(phong::Phong {
+                n,
+                kd: c(0.5),
+                ks: c(0.0),
+                shininess: 1.0,
+            }),
+            Bsdf::Ggx(ggx::Ggx {
+                n,
+                kd: c(0.4),
+                ks: c(0.4),
+                alpha: 0.2,
+            }),
+            Bsdf::Ggx(ggx::Ggx {
+                n,
+                kd: c(0.0),
+                ks: c(0.6),
+                alpha: 0.5,
+            }),
+        ];
+        for (k, b) in bsdfs.iter().enumerate() {
+            for &wo in &views[..3] {
+                chi2_test(
+                    &format!("bsdf {k}, wo·n {:.2}", wo.dot(n)),
+                    |u, v| b.sample_reusing(wo, u, v).map(|s| s.wi),
+                    |wi| b.pdf(wo, wi),
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn one_lobe_uses_the_first_number_as_it_is() {
+        let (n, views) = normal_and_views();
+        let b = Bsdf::Phong(phong::Phong {
+            n,
+            kd: Color::splat(0.5),
+            ks: Color::ZERO,
+            shininess: 1.0,
+        });
+        for k in 0..64 {
+            let (u, v) = ((k as f32 * 0.618).fract(), (k as f32 * 0.382).fract());
+            let (a, b) = (b.sample_reusing(views[1], u, v), b.sample(views[1], 0.0, u, v));
+            assert_eq!(a.map(|s| s.wi), b.map(|s| s.wi));
+        }
     }
 }
