@@ -191,43 +191,27 @@ mod tests {
     use super::*;
     use crate::sampling::chi2::chi2_test;
 
+    fn phong(n: Vec3A, kd: f32, ks: f32, shininess: f32) -> Bsdf {
+        let (kd, ks) = (Color::splat(kd), Color::splat(ks));
+        Bsdf::Phong(phong::Phong { n, kd, ks, shininess })
+    }
+
+    fn ggx(n: Vec3A, kd: f32, ks: f32, alpha: f32) -> Bsdf {
+        let (kd, ks) = (Color::splat(kd), Color::splat(ks));
+        Bsdf::Ggx(ggx::Ggx { n, kd, ks, alpha })
+    }
+
     #[test]
     fn sampling_with_the_lobe_chosen_by_the_first_number_follows_the_mixture_density() {
         // The same densities as `Bsdf::sample` with a number of its own for the lobe: χ²
         // against the mixture's pdf, for Phong and GGX mixtures and single lobes.
         let (n, views) = normal_and_views();
-        let c = Color::splat;
         let bsdfs = [
-            Bsdf::Phong(phong::Phong {
-                n,
-                kd: c(0.5),
-                ks: c(0.3),
-                shininess: 5.0,
-            }),
-            Bsdf::Phong(phong::Phong {
-                n,
-                kd: c(0.1),
-                ks: c(0.5),
-                shininess: 1000.0,
-            }),
-            Bsdf::Phong(phong::Phong {
-                n,
-                kd: c(0.5),
-                ks: c(0.0),
-                shininess: 1.0,
-            }),
-            Bsdf::Ggx(ggx::Ggx {
-                n,
-                kd: c(0.4),
-                ks: c(0.4),
-                alpha: 0.2,
-            }),
-            Bsdf::Ggx(ggx::Ggx {
-                n,
-                kd: c(0.0),
-                ks: c(0.6),
-                alpha: 0.5,
-            }),
+            phong(n, 0.5, 0.3, 5.0),
+            phong(n, 0.1, 0.5, 1000.0),
+            phong(n, 0.5, 0.0, 1.0),
+            ggx(n, 0.4, 0.4, 0.2),
+            ggx(n, 0.0, 0.6, 0.5),
         ];
         for (k, b) in bsdfs.iter().enumerate() {
             for &wo in &views[..3] {
@@ -243,12 +227,7 @@ mod tests {
     #[test]
     fn one_lobe_uses_the_first_number_as_it_is() {
         let (n, views) = normal_and_views();
-        let b = Bsdf::Phong(phong::Phong {
-            n,
-            kd: Color::splat(0.5),
-            ks: Color::ZERO,
-            shininess: 1.0,
-        });
+        let b = phong(n, 0.5, 0.0, 1.0);
         for k in 0..64 {
             let (u, v) = ((k as f32 * 0.618).fract(), (k as f32 * 0.382).fract());
             let (a, b) = (b.sample_reusing(views[1], u, v), b.sample(views[1], 0.0, u, v));
