@@ -41,10 +41,13 @@ unsafe fn row_ptr(node: &WideNode, offset: usize, lane: usize) -> *const f32 {
 /// What the box test needs of a ray, per axis.
 #[derive(Clone, Copy)]
 pub struct RayBoxes {
-    origin: [f32; 3],
-    inv_dir: [f32; 3],
+    // Kept as vectors, not arrays: the per-axis broadcasts are then made in registers.
+    // Through arrays, each went to memory and back, and one 8-byte load spanned two of
+    // the stores that made it, which cannot be forwarded (a stall on every query).
+    origin: Vec3A,
+    inv_dir: Vec3A,
     /// `inv_dir` times the far widening (left alone where that overflows).
-    inv_far: [f32; 3],
+    inv_far: Vec3A,
     /// Byte offsets in a [`WideNode`] of the rows of `bounds` holding the planes the ray
     /// enters and leaves by (offsets, not indices: a node visit then adds nothing).
     near_row: [usize; 3],
@@ -62,11 +65,10 @@ impl RayBoxes {
         let widened = r.inv_dir * FAR_WIDENING;
         let inv_far = Vec3A::select(widened.is_finite_mask(), widened, r.inv_dir);
         let positive = r.inv_dir.cmpge(Vec3A::ZERO).bitmask();
-        let inv = r.inv_dir.to_array();
         RayBoxes {
-            origin: r.ray.origin.to_array(),
-            inv_dir: inv,
-            inv_far: inv_far.to_array(),
+            origin: r.ray.origin,
+            inv_dir: r.inv_dir,
+            inv_far,
             near_row: [0, 1, 2].map(|a| ROW_BYTES * if positive >> a & 1 != 0 { a } else { a + 3 }),
             far_row: [0, 1, 2].map(|a| ROW_BYTES * if positive >> a & 1 != 0 { a + 3 } else { a }),
             zero: [r.zero_axes.test(0), r.zero_axes.test(1), r.zero_axes.test(2)],
@@ -89,9 +91,9 @@ impl RayBoxes {
 /// of this file checks every box test against f64 arithmetic on grazing rays.
 #[derive(Clone, Copy)]
 pub struct FmaOffsets {
-    pub(super) near: [f32; 3],
-    pub(super) far: [f32; 3],
-    pub(super) inv_far: [f32; 3],
+    pub(super) near: Vec3A,
+    pub(super) far: Vec3A,
+    pub(super) inv_far: Vec3A,
 }
 
 impl FmaOffsets {
@@ -110,11 +112,7 @@ impl FmaOffsets {
         let c = p.abs() * Self::OFFSET;
         let (near, far, inv_far) = (p + c, p - c, inv * Self::WIDENING);
         let finite = inv.is_finite_mask() & near.is_finite_mask() & far.is_finite_mask() & inv_far.is_finite_mask();
-        finite.all().then(|| FmaOffsets {
-            near: near.to_array(),
-            far: far.to_array(),
-            inv_far: inv_far.to_array(),
-        })
+        finite.all().then_some(FmaOffsets { near, far, inv_far })
     }
 }
 
@@ -164,20 +162,26 @@ pub struct PlaneLanes<L> {
     far_mul: [L; 3],
     far_off: [L; 3],
     t_min: L,
-    rb: RayBoxes,
+    /// The rows of the planes the ray enters and leaves by, and its zero axes (see
+    /// [`RayBoxes`]).
+    near_row: [usize; 3],
+    far_row: [usize; 3],
+    zero: [bool; 3],
 }
 
 impl<L: Lanes> PlaneLanes<L> {
     #[inline(always)]
-    unsafe fn new(r: &RayBoxes, [near_mul, near_off, far_mul, far_off]: [[f32; 3]; 4]) -> PlaneLanes<L> {
-        let splat = |v: [f32; 3]| v.map(|x| L::splat(x));
+    unsafe fn new(r: &RayBoxes, [near_mul, near_off, far_mul, far_off]: [Vec3A; 4]) -> PlaneLanes<L> {
+        let splat = |v: Vec3A| [L::splat(v.x), L::splat(v.y), L::splat(v.z)];
         PlaneLanes {
             near_mul: splat(near_mul),
             near_off: splat(near_off),
             far_mul: splat(far_mul),
             far_off: splat(far_off),
             t_min: L::splat(r.t_min),
-            rb: *r,
+            near_row: r.near_row,
+            far_row: r.far_row,
+            zero: r.zero,
         }
     }
 }
@@ -240,20 +244,19 @@ impl<L: Lanes, D: Distance<L>> BoxTest for Planes<L, D> {
     type Lanes = L;
     #[inline(always)]
     unsafe fn group<const ZERO: bool>(node: &WideNode, r: &PlaneLanes<L>, t_max: f32, first: usize) -> (L, L::Mask) {
-        let rb = &r.rb;
         let mut near = r.t_min;
         let mut far = L::splat(t_max);
         let mut inside = L::all();
         for a in 0..3 {
-            if ZERO && rb.zero[a] {
+            if ZERO && r.zero[a] {
                 // The plain test's offset is the origin.
                 let o = r.near_off[a];
                 let lo = row::<L>(node, a * ROW_BYTES, first);
                 let hi = row::<L>(node, (a + 3) * ROW_BYTES, first);
                 inside = L::and(inside, L::and(lo.le(o), o.le(hi)));
             } else {
-                let n = D::distance(row::<L>(node, rb.near_row[a], first), r.near_mul[a], r.near_off[a]);
-                let f = D::distance(row::<L>(node, rb.far_row[a], first), r.far_mul[a], r.far_off[a]);
+                let n = D::distance(row::<L>(node, r.near_row[a], first), r.near_mul[a], r.near_off[a]);
+                let f = D::distance(row::<L>(node, r.far_row[a], first), r.far_mul[a], r.far_off[a]);
                 near = n.max(near);
                 far = f.min(far);
             }
