@@ -276,11 +276,10 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
     // them over through memory costs a stalled store-to-load forward per ray.
     use box_test::Fused;
     use lanes::Avx;
-    let rb = RayBoxes::new(r);
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(b, prims, r, &Fused::prepare(&rb, &offsets))
+        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(b, prims, r, &Fused::prepare(&RayBoxes::new(r), &offsets))
     } else {
-        run_avx2_plain::<Q, P>(b, prims, r, &rb)
+        run_avx2_plain::<Q, P>(b, prims, r)
     }
 }
 
@@ -290,17 +289,14 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
 #[target_feature(enable = "avx2,fma")]
 #[inline(never)]
 #[cold]
-unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    rb: &RayBoxes,
-) -> Q::Answer {
+unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
     use lanes::Avx;
+    // (Made here, not passed in: a reference to it would make the common path store it.)
+    let rb = RayBoxes::new(r);
     if r.zero_axes.any() {
-        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(rb))
+        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
     } else {
-        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(rb))
+        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
     }
 }
 
