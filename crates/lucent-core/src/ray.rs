@@ -103,10 +103,11 @@ impl PreparedRay {
         // and made a query that misses the scene about 30 % slower.
         let negative = d.cmplt(Vec3A::ZERO).bitmask() as usize >> kz & 1;
         let [kx, ky] = AXES_AROUND[2 * kz + negative];
-        let pick = |v: Vec3A, k: usize| [v.x, v.y, v.z, 0.0][k & 3];
+        // Each vector spilled once, its components read by index (`& 3`: in bounds).
+        let [o, dk, inv] = [ray.origin, d, inv_dir].map(|v| [v.x, v.y, v.z, 0.0]);
         // `1/d[kz]` is `inv_dir[kz]`: the dominant component of a non-zero direction is
         // not zero, so its reciprocal was not replaced.
-        let sz = pick(inv_dir, kz);
+        let sz = inv[kz & 3];
         PreparedRay {
             ray,
             inv_dir,
@@ -114,9 +115,9 @@ impl PreparedRay {
             kx,
             ky,
             kz,
-            origin_k: [pick(ray.origin, kx), pick(ray.origin, ky), pick(ray.origin, kz)],
-            sx: pick(d, kx) * sz,
-            sy: pick(d, ky) * sz,
+            origin_k: [o[kx & 3], o[ky & 3], o[kz & 3]],
+            sx: dk[kx & 3] * sz,
+            sy: dk[ky & 3] * sz,
             sz,
         }
     }
