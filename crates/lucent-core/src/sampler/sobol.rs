@@ -119,14 +119,33 @@ pub fn sample1(i_reversed: u32, seeds: Seeds) -> f32 {
 #[inline(always)]
 pub fn sample2(i_reversed: u32, seeds: Seeds) -> (f32, f32) {
     let s = shuffled(i_reversed, seeds.index);
-    let x = scramble_reversed(s, seeds.x).reverse_bits();
-    let y = scramble_reversed(sobol_dimension_1_reversed(s), seeds.y).reverse_bits();
+    let x = scramble_reversed(s, seeds.x);
+    let y = scramble_reversed(sobol_dimension_1_reversed(s), seeds.y);
+    let (x, y) = reverse_both(x, y);
     (to_unit(x), to_unit(y))
+}
+
+/// `(x.reverse_bits(), y.reverse_bits())` by one 64-bit reversal: x86-64 has no bit
+/// reversal instruction, and a 64-bit one costs what a 32-bit one does.
+#[inline(always)]
+fn reverse_both(x: u32, y: u32) -> (u32, u32) {
+    let r = ((x as u64) << 32 | y as u64).reverse_bits();
+    (r as u32, (r >> 32) as u32)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn both_reversed_at_once_are_each_reversed() {
+        let mut x = 0x1234_5678u32;
+        for _ in 0..10_000 {
+            x = x.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+            let y = x.rotate_left(13) ^ 0xdead_beef;
+            assert_eq!(reverse_both(x, y), (x.reverse_bits(), y.reverse_bits()));
+        }
+    }
 
     #[test]
     fn the_unscrambled_second_dimension_is_sobols() {
