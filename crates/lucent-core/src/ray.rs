@@ -81,6 +81,10 @@ impl PreparedRay {
 
     #[inline]
     pub fn new(ray: Ray) -> PreparedRay {
+        // Rebuilt field by field: a copy of the whole struct read its last 16 bytes (the
+        // two limits and padding) in one load, which the CPU cannot forward from the
+        // narrower stores of a ray its caller has just made.
+        let ray = Ray::segment(ray.origin, ray.dir, ray.t_min, ray.t_max);
         let d = ray.dir;
         // One vector division; the rare zero or subnormal components are fixed after.
         let mut inv_dir = Vec3A::ONE / d;

@@ -65,9 +65,13 @@ impl Geometry {
     /// Whether a primitive outside the structure (a plane) blocks `r`.
     #[inline]
     fn unbounded_occludes(&self, r: &PreparedRay) -> bool {
-        self.unbounded
-            .iter()
-            .any(|&i| self.primitives[i as usize].occludes(r, r.ray.t_max))
+        // (The emptiness test first: the search was not inlined, and most scenes have no
+        // planes.)
+        !self.unbounded.is_empty()
+            && self
+                .unbounded
+                .iter()
+                .any(|&i| self.primitives[i as usize].occludes(r, r.ray.t_max))
     }
 
     /// [`Geometry::occluded`] of each of `rays` (`out[i]` for `rays[i]`), coherent rays
