@@ -43,7 +43,7 @@ fn sample_linear(u: f32, a: f32, b: f32) -> f32 {
         return u;
     }
     let x = u * (a + b) / (a + ((1.0 - u) * a * a + u * b * b).sqrt());
-    x.min(1.0 - f32::EPSILON / 2.0)
+    x.min(crate::sampling::ONE_BELOW)
 }
 
 impl EnvironmentLight {

@@ -10,6 +10,8 @@
 //! Sums are kept in f64: a 100,000-item distribution summed in f32 would lose the
 //! smallest items to rounding.
 
+use super::ONE_BELOW;
+
 /// A density proportional to `weights[i]` on `[i/n, (i+1)/n)`.
 #[derive(Clone, Debug)]
 pub struct Distribution1D {
@@ -114,9 +116,6 @@ impl Distribution1D {
         self.density(i)
     }
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// A density on the unit square proportional to `weights[row · width + column]` on each
 /// cell of a `width × height` grid; `(u, v)` with u along a row, v down the rows.

@@ -15,3 +15,6 @@ pub mod warp;
 
 #[cfg(test)]
 pub mod chi2;
+
+/// The largest f32 below 1: where a number in [0, 1) made from another must stay.
+pub const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;

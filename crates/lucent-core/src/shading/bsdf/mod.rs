@@ -135,7 +135,7 @@ impl Bsdf {
         } else {
             (u - share) / (1.0 - share)
         };
-        self.sample(wo, u, rest.clamp(0.0, 1.0 - f32::EPSILON / 2.0), v)
+        self.sample(wo, u, rest.clamp(0.0, crate::sampling::ONE_BELOW), v)
     }
 
     /// A direction drawn in proportion to the BSDF (`importancesampling brdf`): `pick`
