@@ -6,7 +6,9 @@
 //! `C_trav + (A_l·P(N_l) + A_r·P(N_r)) / A`, where `P(n) = ⌈n/4⌉` counts the four-wide
 //! packets a leaf of `n` primitives needs, and the node becomes a leaf when that is no
 //! cheaper than its own packets. (Only the planes between occupied bins are priced, and a
-//! node of one packet is a leaf without binning: the same choices, for less.) Below
+//! node of one packet is a leaf without binning: the same choices, for less.) Near the
+//! root, a node of one packet is split too when `(A_l + A_r) / A < 1` (see
+//! [`SMALL_SPLIT_DEPTH`]): the walls of a room. Below
 //! depth 48 (only pathological inputs get there), and when no plane separates the
 //! centroids, nodes are split at the object median so the depth stays bounded. The build
 //! works on a flat array of 32-byte references ([`super::build_ref`]) that it partitions
@@ -31,6 +33,17 @@ pub const MAX_LEAF: usize = 4;
 /// dragons: 2 beats 0.5 and 1, and gives smaller trees; 3 and 4 are no better).
 const TRAVERSAL_COST: f32 = 2.0;
 const MEDIAN_SPLIT_DEPTH: usize = 48;
+/// Nodes of one packet shallower than this are split when their two sides' boxes are
+/// smaller than theirs (`A_l + A_r < A`), with no traversal cost: the collapse puts the
+/// two sides in free slots of the wide node above, or merges them back into one leaf
+/// when it has none ([`super::wide`]). That separates the big flat pieces of a small
+/// scene: the Cornell box's walls, packed four triangles to a leaf, made leaf boxes as
+/// large as the room, which every ray inside it entered. Split, the kernel runs 34 % and
+/// 39 % fewer instructions on the box's diffuse and shadow rays, and the path-traced box
+/// 15 % fewer in all (the same answers).
+/// A binary tree has at most 2ᵈ nodes at depth d, so this adds at most 2⁶ packets
+/// (10 KB) to any scene: a big mesh's nodes of one packet lie far deeper.
+const SMALL_SPLIT_DEPTH: usize = 6;
 /// Subtrees larger than this may be built with their two halves in parallel; smaller
 /// ones are not worth a task.
 const PARALLEL_REFS: usize = 4096;
@@ -191,7 +204,7 @@ fn choose_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb, depth: usize) -
     if depth >= MEDIAN_SPLIT_DEPTH {
         return Some(median_split(refs, cb));
     }
-    match sah_split(refs, bounds, cb) {
+    match sah_split(refs, bounds, cb, depth) {
         Some(s) => Some(s),
         None if count > MAX_LEAF => Some(median_split(refs, cb)),
         None => None,
@@ -252,19 +265,23 @@ struct Split {
 
 /// Partitions at the best SAH plane, or returns `None` when a leaf is cheaper (or no
 /// plane separates the centroids).
-fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb) -> Option<Split> {
+fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb, depth: usize) -> Option<Split> {
     let count = refs.len();
     // A split costs at least the traversal step, no less than one packet: a node that
     // fits in one packet is a leaf, whatever its planes would cost (most nodes are
-    // these, so they are not binned for nothing).
-    if count <= MAX_LEAF && TRAVERSAL_COST >= packets(count) {
+    // these, so they are not binned for nothing) -- except near the root, where the
+    // step is free (see SMALL_SPLIT_DEPTH).
+    let small = count <= MAX_LEAF;
+    let free_step = small && depth < SMALL_SPLIT_DEPTH;
+    if small && !free_step && TRAVERSAL_COST >= packets(count) {
         return None;
     }
     let (bins, scale) = bin_node(refs, cb);
     let (cost, axis, split_bin) = cheapest_plane(&bins, scale)?;
     let a = area(bounds.min, bounds.max);
-    let split_cost = TRAVERSAL_COST + if a > 0.0 { cost / a } else { packets(count) };
-    if count <= MAX_LEAF && split_cost >= packets(count) {
+    let step = if free_step { 0.0 } else { TRAVERSAL_COST };
+    let split_cost = step + if a > 0.0 { cost / a } else { packets(count) };
+    if small && split_cost >= packets(count) {
         return None;
     }
     let (mid, centroids) = partition_with_centroids(refs, |r| r.bin(axis) < split_bin);
@@ -363,5 +380,54 @@ mod tests {
             let tree = pool.install(|| build(items.iter().copied()));
             assert!(shape(&tree) == expected, "{threads} threads");
         }
+    }
+
+    #[test]
+    fn a_rooms_walls_get_leaves_of_their_own() {
+        // Five walls of the 2 × 2 × 2 room (no front), two triangles each: each
+        // triangle's box is its wall's. Four triangles fit one packet, but a leaf of two
+        // walls has the room's box, which every ray inside the room enters.
+        let v = |x: f32, y: f32, z: f32| Vec3A::new(x, y, z);
+        let walls = [
+            (v(-1.0, 0.0, -1.0), v(1.0, 0.0, 1.0)),
+            (v(-1.0, 2.0, -1.0), v(1.0, 2.0, 1.0)),
+            (v(-1.0, 0.0, -1.0), v(1.0, 2.0, -1.0)),
+            (v(-1.0, 0.0, -1.0), v(-1.0, 2.0, 1.0)),
+            (v(1.0, 0.0, -1.0), v(1.0, 2.0, 1.0)),
+        ];
+        // Two boxes per wall with slightly different centroids, as its two triangles'.
+        let items: Vec<(u32, Aabb)> = (0..10u32)
+            .map(|i| {
+                let (lo, hi) = walls[i as usize / 2];
+                (i, Aabb::new(lo, hi))
+            })
+            .collect();
+        let tree = build(items.iter().copied());
+        for n in &tree.nodes {
+            if let Kind::Leaf { start, count } = n.kind {
+                let prims = &tree.refs[start as usize..(start + count) as usize];
+                let wall = prims[0].prim / 2;
+                assert!(
+                    prims.iter().all(|r| r.prim / 2 == wall),
+                    "a leaf holds two walls: {n:?}"
+                );
+            }
+        }
+        // Deeper down, one packet stays one leaf: the same boxes far from the root
+        // (below a 2⁸-way split of many copies) are not split.
+        let many: Vec<(u32, Aabb)> = (0..(10u32 << 8))
+            .map(|i| {
+                let (lo, hi) = walls[(i % 10) as usize / 2];
+                let shift = v((i / 10) as f32 * 10.0, 0.0, 0.0);
+                (i, Aabb::new(lo + shift, hi + shift))
+            })
+            .collect();
+        let tree = build(many.iter().copied());
+        let leaves = tree
+            .nodes
+            .iter()
+            .filter(|n| matches!(n.kind, Kind::Leaf { .. }))
+            .count();
+        assert!(leaves < 256 * 5, "{leaves} leaves");
     }
 }
