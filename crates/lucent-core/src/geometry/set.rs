@@ -33,7 +33,11 @@ impl Geometry {
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
         let r = PreparedRay::new(*ray);
         let mut best = self.accel.closest_hit(&self.primitives, &r);
-        self.nearer_unbounded(&r, &mut best);
+        // (The emptiness test here: the search is not inlined, and most scenes have no
+        // planes.)
+        if !self.unbounded.is_empty() {
+            self.nearer_unbounded(&r, &mut best);
+        }
         best
     }
 
