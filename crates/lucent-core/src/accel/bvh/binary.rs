@@ -385,7 +385,7 @@ mod tests {
     }
 
     #[test]
-    fn a_rooms_walls_get_leaves_of_their_own() {
+    fn a_rooms_walls_get_binary_leaves_of_their_own() {
         // Five walls of the 2 × 2 × 2 room (no front), two triangles each: each
         // triangle's box is its wall's. Four triangles fit one packet, but a leaf of two
         // walls has the room's box, which every ray inside the room enters.
@@ -397,7 +397,7 @@ mod tests {
             (v(-1.0, 0.0, -1.0), v(-1.0, 2.0, 1.0)),
             (v(1.0, 0.0, -1.0), v(1.0, 2.0, 1.0)),
         ];
-        // Two boxes per wall with slightly different centroids, as its two triangles'.
+        // Two boxes per wall, the same: both triangles of a wall's quad span it.
         let items: Vec<(u32, Aabb)> = (0..10u32)
             .map(|i| {
                 let (lo, hi) = walls[i as usize / 2];
