@@ -82,6 +82,8 @@ fn pow_one(x: f32, y: f64) -> f32 {
     // terms to z¹⁵ leave a relative error below 4e-14.
     let z = (m - 1.0) / (m + 1.0);
     let w = z * z;
+    // (Not left to rustfmt, which takes minutes over nested sums this deep.)
+    #[rustfmt::skip]
     let series = 1.0
         + w * (1.0 / 3.0
             + w * (1.0 / 5.0
@@ -96,6 +98,7 @@ fn pow_one(x: f32, y: f64) -> f32 {
     let f = t - (shifted - ROUND_MAGIC);
     // 2^f = e^g, g = f ln 2 in [−0.347, 0.347]: Taylor to degree 11, error below 1e-14.
     let g = f * std::f64::consts::LN_2;
+    #[rustfmt::skip]
     let p = 1.0
         + g * (1.0
             + g * (1.0 / 2.0
