@@ -184,3 +184,78 @@ fn the_largest_sample_count_needs_no_table_of_its_samples() {
     assert_eq!((film.width, film.height), (2, 2));
     assert!(film.pixels.iter().all(|c| c.is_finite()));
 }
+
+#[test]
+fn the_ray_tracer_gives_each_sample_of_a_batch_its_own_colour() {
+    use lucent_core::integrator::{CameraHit, TraceCounts};
+    use lucent_core::math::Color;
+    use lucent_core::sampler::{Sampler, SamplerKind};
+    use lucent_io::session::{Session, SessionOptions};
+    // The renderer hands the ray tracer its camera samples in batches, whose first
+    // shadow rays toward point and directional lights it traces together. Every sample
+    // must come out as it does alone — the same bits, the same rays counted — here with
+    // two point lights (one attenuated, one hidden from part of the floor by a sphere), a
+    // directional light, an area light, glass, glossy and mirror surfaces, and rays that
+    // meet nothing.
+    let text = "size 24 18\ncamera 0 2 6 0 0.5 0 0 1 0 50\nlightsamples 4\nmaxdepth 4\n\
+                attenuation 1 0.1 0\npoint 2 5 3 0.8 0.8 0.8\nattenuation 1 0 0\npoint -3 3 1 0.5 0.4 0.3\n\
+                directional 1 1 1 0.3 0.3 0.3\nquadLight -1 4 -1 0 0 2 2 0 0 2 2 2\n\
+                ambient 0.05 0.05 0.05\ndiffuse 0.6 0.6 0.6\nspecular 0.3 0.3 0.3\nshininess 20\n\
+                plane 0 0 0 0 1 0\nsphere 2.2 0.6 -0.5 0.6\nspecular 0.7 0.7 0.7\nglossy 30 4\nsphere -1 1 0 1\n\
+                glossy off\ntransparent 0.9 0.9 0.9\nior 1.5\nspecular 1 1 1\ndiffuse 0 0 0\nsphere 1.2 0.7 0.5 0.7\n";
+    let mut session = Session::parse_text("t.test", text.as_bytes(), SessionOptions::default());
+    session.build();
+    let built = session.built.as_ref().expect("the scene builds");
+    let (scene, integrator) = (&built.scene, &built.integrator);
+    let res = built.settings.resolution;
+    let (mut rays, mut samplers) = (Vec::new(), Vec::new());
+    for y in 0..res.height {
+        for x in 0..res.width {
+            for i in 0..2 {
+                let mut s = Sampler::start(SamplerKind::Independent, 0, x, y, i);
+                let (u, v) = s.uniform2();
+                rays.push(
+                    scene
+                        .camera
+                        .ray(res, (x as f32 + u) as f64, (y as f32 + v) as f64, (0.5, 0.5)),
+                );
+                samplers.push(s);
+            }
+        }
+    }
+    let mut hits = vec![None; rays.len()];
+    scene.closest_hits(&rays, &mut hits);
+    let misses = hits.iter().filter(|h| h.is_none()).count();
+    assert!(misses > 50 && misses < rays.len() - 300, "{misses} of {}", rays.len());
+
+    let mut alone_counts = TraceCounts::default();
+    let alone: Vec<Color> = rays
+        .iter()
+        .zip(&samplers)
+        .map(|(r, s)| integrator.radiance(scene, r, CameraHit::Untraced, &mut s.clone(), &mut alone_counts))
+        .collect();
+    let distinct: std::collections::HashSet<[u32; 3]> = alone.iter().map(|c| c.to_array().map(f32::to_bits)).collect();
+    assert!(distinct.len() > 300, "{}", distinct.len());
+    // Batches of the renderer's size, of an odd size, and one of every sample.
+    for size in [64, 7, rays.len()] {
+        let mut counts = TraceCounts::default();
+        let mut out = vec![Color::ZERO; rays.len()];
+        let mut batch_samplers = samplers.clone();
+        for (((r, h), s), o) in rays
+            .chunks(size)
+            .zip(hits.chunks(size))
+            .zip(batch_samplers.chunks_mut(size))
+            .zip(out.chunks_mut(size))
+        {
+            integrator.radiances(scene, r, h, s, &mut counts, o);
+        }
+        for (k, (a, b)) in alone.iter().zip(&out).enumerate() {
+            assert_eq!(
+                a.to_array().map(f32::to_bits),
+                b.to_array().map(f32::to_bits),
+                "sample {k}, batches of {size}"
+            );
+        }
+        assert_eq!(counts, alone_counts, "batches of {size}");
+    }
+}

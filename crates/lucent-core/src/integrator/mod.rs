@@ -100,6 +100,25 @@ pub trait Integrator: Sync {
         counts: &mut TraceCounts,
     ) -> Color;
 
+    /// [`Integrator::radiance`] of a batch of camera samples whose camera rays were
+    /// traced together (`hits[k]` the closest hit of `rays[k]`, `samplers[k]` the
+    /// sample's numbers), into `out[k]`: each the very colour `radiance` gives. One at a
+    /// time unless an integrator traces the next rays of the batch together too (the ray
+    /// tracer: [`whitted`]).
+    fn radiances(
+        &self,
+        scene: &Scene,
+        rays: &[Ray],
+        hits: &[Option<Hit>],
+        samplers: &mut [Sampler],
+        counts: &mut TraceCounts,
+        out: &mut [Color],
+    ) {
+        for (k, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+            out[k] = self.radiance(scene, ray, CameraHit::Traced(*hit), &mut samplers[k], counts);
+        }
+    }
+
     fn pixel_sampling(&self) -> PixelSampling {
         PixelSampling::Stratified
     }

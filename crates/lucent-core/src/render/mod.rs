@@ -237,14 +237,13 @@ pub fn render_after(
 /// order, have their camera rays traced at once (in packets, [`Scene::closest_hits`]).
 const CAMERA_BATCH: usize = 64;
 
-/// A camera sample made, waiting for its ray's closest hit.
+/// A camera sample made, waiting for its ray's closest hit (its ray and its sampler,
+/// past the numbers the camera drew, wait beside it).
 struct CameraSample {
     /// The pixel's index in the tile (reading order).
     pixel: usize,
     x: u32,
     y: u32,
-    /// The sampler, past the numbers the camera drew.
-    sampler: Sampler,
 }
 
 fn render_tile(
@@ -292,23 +291,28 @@ fn render_tile(
     let batch = if job.noise_threshold.is_some() { 1 } else { CAMERA_BATCH };
     let mut made: Vec<CameraSample> = Vec::with_capacity(batch);
     let mut rays: Vec<Ray> = Vec::with_capacity(batch);
+    let mut samplers: Vec<Sampler> = Vec::with_capacity(batch);
     let mut hits = vec![None; batch];
-    let mut finish = |made: &mut Vec<CameraSample>, rays: &mut Vec<Ray>, pixels: &mut [PixelResult]| {
+    let mut colors = vec![Color::ZERO; batch];
+    let mut finish = |made: &mut Vec<CameraSample>,
+                      rays: &mut Vec<Ray>,
+                      samplers: &mut Vec<Sampler>,
+                      pixels: &mut [PixelResult]| {
+        let colors = &mut colors[..rays.len()];
         if batch > 1 {
-            scene.closest_hits(rays, &mut hits[..rays.len()]);
+            let hits = &mut hits[..rays.len()];
+            scene.closest_hits(rays, hits);
+            integrator.radiances(scene, rays, hits, samplers, &mut counts, colors);
+        } else {
+            for ((ray, sampler), c) in rays.iter().zip(samplers.iter_mut()).zip(colors.iter_mut()) {
+                *c = integrator.radiance(scene, ray, CameraHit::Untraced, sampler, &mut counts);
+            }
         }
-        for (k, (s, ray)) in made.drain(..).zip(rays.drain(..)).enumerate() {
-            let camera = if batch > 1 {
-                CameraHit::Traced(hits[k])
-            } else {
-                CameraHit::Untraced
-            };
-            let mut sampler = s.sampler;
+        for ((s, ray), &c) in made.drain(..).zip(rays.drain(..)).zip(colors.iter()) {
             let p = &mut pixels[s.pixel];
             if job.aovs {
                 p.aov.add_sample(&aov::first_surface(scene, &ray, &mut counts));
             }
-            let c = integrator.radiance(scene, &ray, camera, &mut sampler, &mut counts);
             let c = if c.is_finite() {
                 c
             } else {
@@ -330,6 +334,7 @@ fn render_tile(
                 }
             }
         }
+        samplers.clear();
     };
     let mut pixel = 0;
     for y in tile.y0..tile.y1 {
@@ -380,15 +385,16 @@ fn render_tile(
                         .camera
                         .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens),
                 );
-                made.push(CameraSample { pixel, x, y, sampler });
+                made.push(CameraSample { pixel, x, y });
+                samplers.push(sampler);
                 if made.len() == batch {
-                    finish(&mut made, &mut rays, &mut pixels);
+                    finish(&mut made, &mut rays, &mut samplers, &mut pixels);
                 }
             }
             pixel += 1;
         }
     }
-    finish(&mut made, &mut rays, &mut pixels);
+    finish(&mut made, &mut rays, &mut samplers, &mut pixels);
     let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
     for p in &pixels {
         taken_min = taken_min.min(p.taken);

@@ -34,11 +34,18 @@
 //! The ray tree is walked with an explicit stack, in the order of the recursion it
 //! stands for, so that no scene can overflow the thread's stack; a branch whose weight
 //! can no longer show is not traced (adaptive depth control, [`super::depth`]).
+//!
+//! The renderer hands the ray tracer 64 camera samples at a time: their first hits'
+//! shadow rays toward point and directional lights are traced together
+//! ([`camera_batch`]); where each light term goes until then is [`light_terms`]'s.
+
+mod camera_batch;
+mod light_terms;
 
 use super::depth::DepthControl;
 use super::shadow_batch::ShadowBatch;
 use super::{CameraHit, Integrator, TraceCounts};
-use crate::hit::{SurfacePoint, BACKGROUND};
+use crate::hit::{Hit, SurfacePoint, BACKGROUND};
 use crate::light::Light;
 use crate::math::{Color, Vec3A};
 use crate::pow;
@@ -47,6 +54,7 @@ use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
 use crate::shading::optics::{fresnel_dielectric, lift_above, phong_lobe, reflect_above, refract, side_of};
 use crate::shading::surface;
+use light_terms::{Immediate, LightTerms};
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
 /// 8-bit step: they are not traced.
@@ -101,22 +109,22 @@ pub struct Whitted {
 }
 
 impl Whitted {
-    /// The local terms at the closest hit of `ray` (ambient, emission, lights) and the
-    /// hit; `None` when the ray escapes.
-    fn shade(&self, t: &mut Tracing, ray: &Ray) -> Option<(Color, SurfacePoint)> {
+    /// The local terms at `hit`, the closest hit of `ray` (ambient, emission, lights),
+    /// into `terms`, and the hit's surface point (with the shading normal).
+    fn shade(&self, t: &mut Tracing, ray: &Ray, hit: &Hit, terms: &mut impl LightTerms) -> SurfacePoint {
         let scene = t.scene;
-        let hit = t.camera.take(scene, ray, t.counts)?;
-        let mut sp = scene.surface_point(&hit, ray);
+        let mut sp = scene.surface_point(hit, ray);
         if let Some(light) = sp.light {
-            return Some((scene.lights[light as usize].radiance_seen(ray.dir, sp.normal), sp));
+            terms.start(scene.lights[light as usize].radiance_seen(ray.dir, sp.normal));
+            return sp;
         }
         let m = &scene.materials[sp.material as usize];
-        let shaded = surface::shade(m, &scene.textures, &sp, || scene.tangents(&hit, ray));
+        let shaded = surface::shade(m, &scene.textures, &sp, || scene.tangents(hit, ray));
         sp.normal = shaded.normal;
         let diffuse = shaded.diffuse;
         let n = sp.normal;
         let view = -ray.dir;
-        let mut color = m.ambient + m.emission;
+        terms.start(m.ambient + m.emission);
         for light in &scene.lights {
             if let Light::Quad(q) = light {
                 let count = self.light_samples.max(1);
@@ -156,7 +164,7 @@ impl Whitted {
                     }
                     first += lanes as u32;
                 }
-                color += shadows.sum(scene) / count as f32;
+                terms.add(shadows.sum(scene) / count as f32);
                 continue;
             }
             let inc = light.incidence(sp.point);
@@ -170,12 +178,9 @@ impl Whitted {
                 continue;
             }
             t.counts.rays += 1;
-            let shadow = sp.spawn_segment(inc.dir, inc.distance);
-            if !scene.occluded(&shadow) {
-                color += inc.intensity * reflected;
-            }
+            terms.add_unless_blocked(sp.spawn_segment(inc.dir, inc.distance), inc.intensity * reflected);
         }
-        Some((color, sp))
+        sp
     }
 
     /// Adds `weight · I(ray)` to `total`. The mirror chain `I0 + S0 (I1 + S1 (…))` runs
@@ -197,92 +202,118 @@ impl Whitted {
             if self.leave_out(t, weight, pending) {
                 return;
             }
-            let Some((local, sp)) = self.shade(t, &ray) else {
+            let Some(hit) = t.camera.take(scene, &ray, t.counts) else {
                 if let Some(env) = &scene.environment {
                     *total += weight * env.radiance(ray.dir);
                 }
                 return;
             };
-            *total += weight * local;
-            // A light's surface reflects nothing.
-            if sp.light.is_some() || depth >= self.max_depth {
-                return;
-            }
-            let m = &scene.materials[sp.material as usize];
-            let (d, n) = (ray.dir, sp.normal);
-            // The side of the true surface the ray came from: reflected rays must leave
-            // on it and refracted rays on the other, whatever the shading normal says.
-            let viewer = side_of(-d, sp.geometric_normal);
-            let mut mirror = m.specular;
-            let mut refracted = None;
-            if m.transparent != Color::ZERO {
-                // Entering when the ray meets the side the normal points to.
-                let entering = d.dot(n) < 0.0;
-                let (facing, n_i, n_t) = if entering { (n, 1.0, m.ior) } else { (-n, m.ior, 1.0) };
-                let f = fresnel_dielectric(-d.dot(facing), n_i, n_t);
-                let through = weight * m.transparent * (1.0 - f);
-                if f < 1.0 && through.max_element() > MIN_WEIGHT {
-                    if let Some(dir) = refract(d, facing, n_i / n_t) {
-                        let dir = if dir.dot(viewer) < 0.0 {
-                            dir
-                        } else {
-                            lift_above(dir, -viewer, 0.01)
-                        };
-                        refracted = Some(Branch::Ray {
-                            ray: sp.spawn(dir),
-                            depth: depth + 1,
-                            weight: through,
-                        });
-                    }
-                }
-                mirror *= f;
-            }
-            // (Opaque mirrors are never pruned here: the course images depend on every
-            // bounce up to `maxdepth`, and adaptive depth control stops them where they
-            // cannot show.)
-            let negligible = m.transparent != Color::ZERO && (weight * mirror).max_element() <= MIN_WEIGHT;
-            let reflected = if mirror == Color::ZERO || negligible {
-                None
-            } else {
-                let r = reflect_above(-d, n, viewer);
-                Some(match m.glossy {
-                    Some(g) => {
-                        let count = if depth == 0 { g.samples.max(1) } else { 1 };
-                        Branch::Glossy {
-                            from: sp,
-                            mirror: r,
-                            side: viewer,
-                            exponent: g.exponent,
-                            left: count,
-                            depth: depth + 1,
-                            weight: weight * mirror / count as f32,
-                        }
-                    }
-                    None => Branch::Ray {
-                        ray: sp.spawn(r),
-                        depth: depth + 1,
-                        weight: weight * mirror,
-                    },
-                })
+            let mut local = Immediate {
+                scene,
+                color: Color::ZERO,
             };
-            match (refracted, reflected) {
-                // The mirror chain goes on in this loop.
-                (
-                    None,
-                    Some(Branch::Ray {
-                        ray: r,
-                        depth: d,
-                        weight: w,
-                    }),
-                ) => (ray, depth, weight) = (r, d, w),
-                (None, None) => return,
-                // The refracted branch is traced first, then the reflected one.
-                (refracted, reflected) => {
-                    for b in [reflected, refracted].into_iter().flatten() {
-                        push(pending, b, t.counts);
-                    }
-                    return;
+            let sp = self.shade(t, &ray, &hit, &mut local);
+            *total += weight * local.color;
+            match self.next(t, &ray, &sp, depth, weight, pending) {
+                Some(next) => (ray, depth, weight) = next,
+                None => return,
+            }
+        }
+    }
+
+    /// What comes after the hit `sp` of `ray` (at `depth`, of weight `weight`): the
+    /// mirror ray that goes on with the chain, or `None` — where the tree ends there, or
+    /// where it branches (a refracted ray, glossy rays), the branches then put on
+    /// `pending`.
+    fn next(
+        &self,
+        t: &mut Tracing,
+        ray: &Ray,
+        sp: &SurfacePoint,
+        depth: u32,
+        weight: Color,
+        pending: &mut Vec<Branch>,
+    ) -> Option<(Ray, u32, Color)> {
+        // A light's surface reflects nothing.
+        if sp.light.is_some() || depth >= self.max_depth {
+            return None;
+        }
+        let m = &t.scene.materials[sp.material as usize];
+        let (d, n) = (ray.dir, sp.normal);
+        // The side of the true surface the ray came from: reflected rays must leave on it
+        // and refracted rays on the other, whatever the shading normal says.
+        let viewer = side_of(-d, sp.geometric_normal);
+        let mut mirror = m.specular;
+        let mut refracted = None;
+        if m.transparent != Color::ZERO {
+            // Entering when the ray meets the side the normal points to.
+            let entering = d.dot(n) < 0.0;
+            let (facing, n_i, n_t) = if entering { (n, 1.0, m.ior) } else { (-n, m.ior, 1.0) };
+            let f = fresnel_dielectric(-d.dot(facing), n_i, n_t);
+            let through = weight * m.transparent * (1.0 - f);
+            if f < 1.0 && through.max_element() > MIN_WEIGHT {
+                if let Some(dir) = refract(d, facing, n_i / n_t) {
+                    let dir = if dir.dot(viewer) < 0.0 {
+                        dir
+                    } else {
+                        lift_above(dir, -viewer, 0.01)
+                    };
+                    refracted = Some(Branch::Ray {
+                        ray: sp.spawn(dir),
+                        depth: depth + 1,
+                        weight: through,
+                    });
                 }
+            }
+            mirror *= f;
+        }
+        // (Opaque mirrors are never pruned here: the course images depend on every bounce
+        // up to `maxdepth`, and adaptive depth control stops them where they cannot show.)
+        let negligible = m.transparent != Color::ZERO && (weight * mirror).max_element() <= MIN_WEIGHT;
+        let reflected = if mirror == Color::ZERO || negligible {
+            None
+        } else {
+            let r = reflect_above(-d, n, viewer);
+            Some(match m.glossy {
+                Some(g) => {
+                    let count = if depth == 0 { g.samples.max(1) } else { 1 };
+                    Branch::Glossy {
+                        from: *sp,
+                        mirror: r,
+                        side: viewer,
+                        exponent: g.exponent,
+                        left: count,
+                        depth: depth + 1,
+                        weight: weight * mirror / count as f32,
+                    }
+                }
+                None => Branch::Ray {
+                    ray: sp.spawn(r),
+                    depth: depth + 1,
+                    weight: weight * mirror,
+                },
+            })
+        };
+        match (refracted, reflected) {
+            // The mirror chain goes on.
+            (None, Some(Branch::Ray { ray, depth, weight })) => Some((ray, depth, weight)),
+            (None, None) => None,
+            // The refracted branch is traced first, then the reflected one.
+            (refracted, reflected) => {
+                for b in [reflected, refracted].into_iter().flatten() {
+                    push(pending, b, t.counts);
+                }
+                None
+            }
+        }
+    }
+
+    /// Traces the branches left on `pending` (and those they add), into `total`.
+    fn finish_tree(&self, t: &mut Tracing, total: &mut Color, pending: &mut Vec<Branch>) {
+        while let Some(b) = pending.pop() {
+            match b {
+                Branch::Ray { ray, depth, weight } => self.follow(t, ray, depth, weight, total, pending),
+                glossy => self.next_glossy(t, glossy, pending),
             }
         }
     }
@@ -372,12 +403,19 @@ impl Integrator for Whitted {
         // Only a tree that branches allocates.
         let mut pending = Vec::new();
         self.follow(&mut t, *ray, 0, Color::ONE, &mut total, &mut pending);
-        while let Some(b) = pending.pop() {
-            match b {
-                Branch::Ray { ray, depth, weight } => self.follow(&mut t, ray, depth, weight, &mut total, &mut pending),
-                glossy => self.next_glossy(&mut t, glossy, &mut pending),
-            }
-        }
+        self.finish_tree(&mut t, &mut total, &mut pending);
         total
+    }
+
+    fn radiances(
+        &self,
+        scene: &Scene,
+        rays: &[Ray],
+        hits: &[Option<Hit>],
+        samplers: &mut [Sampler],
+        counts: &mut TraceCounts,
+        out: &mut [Color],
+    ) {
+        self.batch(scene, rays, hits, samplers, counts, out);
     }
 }
