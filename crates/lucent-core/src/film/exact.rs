@@ -79,6 +79,10 @@ impl ExactSum {
     /// Adds one sample (a finite colour).
     #[inline]
     pub fn add_sample(&mut self, c: Color) {
+        // Black, such as a ray tracer's background, adds nothing (`fixed(±0) = 0`).
+        if c == Color::ZERO {
+            return;
+        }
         self.0[0] += Self::fixed(c.x);
         self.0[1] += Self::fixed(c.y);
         self.0[2] += Self::fixed(c.z);
