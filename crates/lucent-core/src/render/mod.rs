@@ -111,14 +111,16 @@ pub struct RenderControl<'a> {
 struct PixelResult {
     sum: ExactSum,
     taken: u32,
-    /// The sums of their auxiliary passes (zero when the job does not ask for them).
-    aov: AovSum,
-    /// Adaptive sampling's estimate after them (default without a noise threshold).
-    noise: PixelNoise,
 }
 
-/// A tile's pixels, row by row.
-type TilePixels = Vec<PixelResult>;
+/// What a tile's pixels add to the film, row by row: their sums, and only where the job
+/// asks for them (empty otherwise: 150 bytes a pixel that every tile would clear and
+/// copy) the sums of their auxiliary passes and adaptive sampling's estimates.
+struct TilePixels {
+    results: Vec<PixelResult>,
+    aovs: Vec<AovSum>,
+    noise: Vec<PixelNoise>,
+}
 
 struct Tile {
     x0: u32,
@@ -210,17 +212,19 @@ pub fn render_after(
                 let (film, stats) = &mut *guard;
                 stats.add(&s);
                 let tw = (tile.x1 - tile.x0) as usize;
-                for (row, chunk) in pixels.chunks(tw).enumerate() {
+                let no_aov = AovSum::default();
+                for (row, chunk) in pixels.results.chunks(tw).enumerate() {
                     let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
                     for (i, p) in chunk.iter().enumerate() {
-                        film.add(start + i, &p.sum, p.taken, &p.aov);
+                        let k = row * tw + i;
+                        film.add(start + i, &p.sum, p.taken, pixels.aovs.get(k).unwrap_or(&no_aov));
                         if let Some(noise) = &mut film.noise {
-                            noise[start + i] = p.noise;
+                            noise[start + i] = pixels.noise[k];
                         }
                     }
                 }
             }
-            (control.progress)(pixels.len() as u64 * job.samples.len() as u64);
+            (control.progress)(pixels.results.len() as u64 * job.samples.len() as u64);
             true
         })
         .reduce(|| true, |a, b| a & b);
@@ -264,24 +268,37 @@ fn render_tile(
     let shuffle_lens = scene.camera.has_lens() && n <= MAX_LENS_STRATA;
     let mut lens_strata: Vec<u32> = Vec::new();
     // Each pixel's sums; adaptive sampling goes on from the earlier samples' estimate.
-    let mut pixels: Vec<PixelResult> = Vec::with_capacity(((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize);
-    let mut before = Vec::with_capacity(pixels.capacity());
+    let count = ((tile.x1 - tile.x0) * (tile.y1 - tile.y0)) as usize;
+    let adaptive = job.noise_threshold.is_some();
+    let mut pixels = TilePixels {
+        results: Vec::with_capacity(count),
+        aovs: if job.aovs {
+            vec![AovSum::default(); count]
+        } else {
+            Vec::new()
+        },
+        noise: Vec::with_capacity(if adaptive { count } else { 0 }),
+    };
+    // Samples taken before (adaptive sampling counts them).
+    let mut before = Vec::with_capacity(if adaptive { count } else { 0 });
     for y in tile.y0..tile.y1 {
         for x in tile.x0..tile.x1 {
-            let (noise, b) = match earlier {
-                Some(f) => {
-                    let k = (y - job.pixels.y0) as usize * job.pixels.width() as usize + (x - job.pixels.x0) as usize;
-                    (f.noise.as_ref().map_or(PixelNoise::default(), |n| n[k]), f.counts[k])
-                }
-                None => (PixelNoise::default(), 0),
-            };
-            pixels.push(PixelResult {
+            pixels.results.push(PixelResult {
                 sum: ExactSum::default(),
                 taken: 0,
-                aov: AovSum::default(),
-                noise,
             });
-            before.push(b);
+            if adaptive {
+                let (noise, b) = match earlier {
+                    Some(f) => {
+                        let k =
+                            (y - job.pixels.y0) as usize * job.pixels.width() as usize + (x - job.pixels.x0) as usize;
+                        (f.noise.as_ref().map_or(PixelNoise::default(), |n| n[k]), f.counts[k])
+                    }
+                    None => (PixelNoise::default(), 0),
+                };
+                pixels.noise.push(noise);
+                before.push(b);
+            }
         }
     }
     // Samples are made in the tile's order, pixel by pixel, and finished in the same
@@ -297,7 +314,7 @@ fn render_tile(
     let mut finish = |made: &mut Vec<CameraSample>,
                       rays: &mut Vec<Ray>,
                       samplers: &mut Vec<Sampler>,
-                      pixels: &mut [PixelResult]| {
+                      pixels: &mut TilePixels| {
         let colors = &mut colors[..rays.len()];
         if batch > 1 {
             let hits = &mut hits[..rays.len()];
@@ -309,10 +326,10 @@ fn render_tile(
             }
         }
         for ((s, ray), &c) in made.drain(..).zip(rays.drain(..)).zip(colors.iter()) {
-            let p = &mut pixels[s.pixel];
             if job.aovs {
-                p.aov.add_sample(&aov::first_surface(scene, &ray, &mut counts));
+                pixels.aovs[s.pixel].add_sample(&aov::first_surface(scene, &ray, &mut counts));
             }
+            let p = &mut pixels.results[s.pixel];
             let c = if c.is_finite() {
                 c
             } else {
@@ -324,13 +341,13 @@ fn render_tile(
             p.sum.add_sample(c);
             p.taken += 1;
             if let Some(threshold) = job.noise_threshold {
-                p.noise.add(c);
+                let noise = &mut pixels.noise[s.pixel];
+                noise.add(c);
                 // Looked at every 8 samples: a stop then leaves whole 8-point nets of
                 // the Sobol sequences, which cover the pixel evenly.
                 let all = before[s.pixel] + p.taken;
-                if all >= MIN_ADAPTIVE_SAMPLES.min(n) && all % 8 == 0 && p.noise.relative_error(all) < threshold as f64
-                {
-                    p.noise.stopped = true;
+                if all >= MIN_ADAPTIVE_SAMPLES.min(n) && all % 8 == 0 && noise.relative_error(all) < threshold as f64 {
+                    noise.stopped = true;
                 }
             }
         }
@@ -346,7 +363,7 @@ fn render_tile(
                 if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
                     return None;
                 }
-                if pixels[pixel].noise.stopped {
+                if pixels.noise.get(pixel).is_some_and(|p| p.stopped) {
                     break;
                 }
                 let mut sampler = Sampler::start(job.sampler, job.seed, x, y, i);
@@ -396,7 +413,7 @@ fn render_tile(
     }
     finish(&mut made, &mut rays, &mut samplers, &mut pixels);
     let (mut taken_min, mut taken_max, mut taken_all) = (u32::MAX, 0u32, 0u64);
-    for p in &pixels {
+    for p in &pixels.results {
         taken_min = taken_min.min(p.taken);
         taken_max = taken_max.max(p.taken);
         taken_all += p.taken as u64;
