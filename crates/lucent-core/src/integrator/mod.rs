@@ -114,12 +114,26 @@ pub trait Integrator: Sync {
         counts: &mut TraceCounts,
         out: &mut [Color],
     ) {
-        for (k, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-            out[k] = self.radiance(scene, ray, CameraHit::Traced(*hit), &mut samplers[k], counts);
-        }
+        one_at_a_time(self, scene, rays, hits, samplers, counts, out);
     }
 
     fn pixel_sampling(&self) -> PixelSampling {
         PixelSampling::Stratified
+    }
+}
+
+/// [`Integrator::radiances`] sample by sample: the default, and the ray tracer's where a
+/// batch would keep too many shadow rays.
+pub fn one_at_a_time<I: Integrator + ?Sized>(
+    integrator: &I,
+    scene: &Scene,
+    rays: &[Ray],
+    hits: &[Option<Hit>],
+    samplers: &mut [Sampler],
+    counts: &mut TraceCounts,
+    out: &mut [Color],
+) {
+    for (k, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+        out[k] = integrator.radiance(scene, ray, CameraHit::Traced(*hit), &mut samplers[k], counts);
     }
 }

@@ -53,70 +53,58 @@ impl Whitted {
         counts: &mut TraceCounts,
         out: &mut [Color],
     ) {
-        SCRATCH.with_borrow_mut(|scratch| self.batch_with(scene, rays, hits, samplers, counts, out, scratch));
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn batch_with(
-        &self,
-        scene: &Scene,
-        rays: &[Ray],
-        hits: &[Option<Hit>],
-        samplers: &mut [Sampler],
-        counts: &mut TraceCounts,
-        out: &mut [Color],
-        scratch: &mut Scratch,
-    ) {
-        let Scratch { deferred, shaded } = scratch;
-        deferred.clear();
-        shaded.clear();
-        for (k, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-            let mut t = Tracing {
-                scene,
-                camera: CameraHit::Untraced,
-                sampler: &mut samplers[k],
-                counts,
-                dropped: 0.0,
-            };
-            // Samples that meet nothing, or whose tree is left out at once, go alone.
-            let hit = match hit {
-                Some(hit) if !self.leave_out(&mut t, Color::ONE, &[]) => hit,
-                _ => {
-                    out[k] = self.radiance(scene, ray, CameraHit::Traced(*hit), &mut samplers[k], counts);
-                    continue;
-                }
-            };
-            t.counts.rays += 1;
-            let before = deferred.len();
-            let sp = self.shade(&mut t, ray, hit, deferred);
-            shaded.push(Shaded {
-                sample: k,
-                sp,
-                first: deferred.first,
-                terms: before..deferred.len(),
-                dropped: t.dropped,
-            });
-        }
-        deferred.trace(scene);
-
-        // Each first hit's colour, then the rest of its tree, as `radiance` walks it.
-        for s in shaded.drain(..) {
-            let k = s.sample;
-            let mut t = Tracing {
-                scene,
-                camera: CameraHit::Untraced,
-                sampler: &mut samplers[k],
-                counts,
-                dropped: s.dropped,
-            };
-            let mut total = BACKGROUND;
-            total += Color::ONE * deferred.sum(s.first, s.terms);
-            let mut pending = Vec::new();
-            if let Some((ray, depth, weight)) = self.next(&mut t, &rays[k], &s.sp, 0, Color::ONE, &mut pending) {
-                self.follow(&mut t, ray, depth, weight, &mut total, &mut pending);
+        SCRATCH.with_borrow_mut(|scratch| {
+            let Scratch { deferred, shaded } = scratch;
+            deferred.clear();
+            shaded.clear();
+            for (k, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+                let mut t = Tracing {
+                    scene,
+                    camera: CameraHit::Untraced,
+                    sampler: &mut samplers[k],
+                    counts,
+                    dropped: 0.0,
+                };
+                // Samples that meet nothing, or whose tree is left out at once, go alone.
+                let hit = match hit {
+                    Some(hit) if !self.leave_out(&mut t, Color::ONE, &[]) => hit,
+                    _ => {
+                        out[k] = self.radiance(scene, ray, CameraHit::Traced(*hit), &mut samplers[k], counts);
+                        continue;
+                    }
+                };
+                t.counts.rays += 1;
+                let before = deferred.len();
+                let sp = self.shade(&mut t, ray, hit, deferred);
+                shaded.push(Shaded {
+                    sample: k,
+                    sp,
+                    first: deferred.first,
+                    terms: before..deferred.len(),
+                    dropped: t.dropped,
+                });
             }
-            self.finish_tree(&mut t, &mut total, &mut pending);
-            out[k] = total;
-        }
+            deferred.trace(scene);
+
+            // Each first hit's colour, then the rest of its tree, as `radiance` walks it.
+            for s in shaded.drain(..) {
+                let k = s.sample;
+                let mut t = Tracing {
+                    scene,
+                    camera: CameraHit::Untraced,
+                    sampler: &mut samplers[k],
+                    counts,
+                    dropped: s.dropped,
+                };
+                let mut total = BACKGROUND;
+                total += Color::ONE * deferred.sum(s.first, s.terms);
+                let mut pending = Vec::new();
+                if let Some((ray, depth, weight)) = self.next(&mut t, &rays[k], &s.sp, 0, Color::ONE, &mut pending) {
+                    self.follow(&mut t, ray, depth, weight, &mut total, &mut pending);
+                }
+                self.finish_tree(&mut t, &mut total, &mut pending);
+                out[k] = total;
+            }
+        });
     }
 }

@@ -424,11 +424,9 @@ impl Integrator for Whitted {
         // A batch keeps every shadow ray of its first hits, as many as samples × lights:
         // with more lights than this the samples go one at a time, in constant memory.
         if scene.lights.len() > MAX_BATCH_LIGHTS {
-            for (k, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-                out[k] = self.radiance(scene, ray, CameraHit::Traced(*hit), &mut samplers[k], counts);
-            }
-            return;
+            super::one_at_a_time(self, scene, rays, hits, samplers, counts, out);
+        } else {
+            self.batch(scene, rays, hits, samplers, counts, out);
         }
-        self.batch(scene, rays, hits, samplers, counts, out);
     }
 }
