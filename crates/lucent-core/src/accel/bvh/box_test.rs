@@ -266,7 +266,7 @@ impl<L: Lanes, D: Distance<L>> BoxTest for Planes<L, D> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::accel::search_limit;
     use crate::accel::test_sets::Rng;
@@ -275,7 +275,7 @@ mod tests {
 
     /// The slab test in f64 with a true division: within 1e-16 of exact, far inside the
     /// slack every f32 test is allowed. Returns the entry distance when entered.
-    fn exact_entry(lo: [f32; 3], hi: [f32; 3], r: &Ray, t_max: f32) -> Option<f64> {
+    pub(in crate::accel::bvh) fn exact_entry(lo: [f32; 3], hi: [f32; 3], r: &Ray, t_max: f32) -> Option<f64> {
         let (mut near, mut far) = (r.t_min as f64, t_max as f64);
         for a in 0..3 {
             let (o, d) = (r.origin[a] as f64, r.dir[a] as f64);

@@ -19,6 +19,7 @@ mod box_test;
 mod build_ref;
 mod lanes;
 mod packet;
+mod packet_frustum;
 mod ray_lanes;
 pub mod ray_packet;
 mod ray_triangle;

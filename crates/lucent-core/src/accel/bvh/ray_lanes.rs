@@ -43,6 +43,9 @@ pub trait RayLanes: Copy {
     /// Bitwise `self ^ o` and `self | o` of the lanes' bit patterns.
     unsafe fn xor(self, o: Self) -> Self;
     unsafe fn or(self, o: Self) -> Self;
+    /// The largest and the smallest of the lanes of `mask` (not empty).
+    unsafe fn max_of(self, mask: u32) -> f32;
+    unsafe fn min_of(self, mask: u32) -> f32;
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -132,6 +135,20 @@ mod x86 {
         unsafe fn or(self, o: Self) -> Self {
             Rays8(_mm256_or_ps(self.0, o.0))
         }
+        #[inline(always)]
+        unsafe fn max_of(self, mask: u32) -> f32 {
+            let v = Self::select(mask, self, Self::splat(f32::NEG_INFINITY)).0;
+            let m = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+            let m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+            _mm_cvtss_f32(_mm_max_ss(m, _mm_shuffle_ps::<1>(m, m)))
+        }
+        #[inline(always)]
+        unsafe fn min_of(self, mask: u32) -> f32 {
+            let v = Self::select(mask, self, Self::splat(f32::INFINITY)).0;
+            let m = _mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v));
+            let m = _mm_min_ps(m, _mm_movehl_ps(m, m));
+            _mm_cvtss_f32(_mm_min_ss(m, _mm_shuffle_ps::<1>(m, m)))
+        }
     }
 
     /// Sixteen rays (AVX-512 F; comparisons straight into mask registers).
@@ -203,6 +220,14 @@ mod x86 {
         #[inline(always)]
         unsafe fn or(self, o: Self) -> Self {
             Rays16(_mm512_castsi512_ps(_mm512_or_si512(bits512(self.0), bits512(o.0))))
+        }
+        #[inline(always)]
+        unsafe fn max_of(self, mask: u32) -> f32 {
+            _mm512_mask_reduce_max_ps(mask as __mmask16, self.0)
+        }
+        #[inline(always)]
+        unsafe fn min_of(self, mask: u32) -> f32 {
+            _mm512_mask_reduce_min_ps(mask as __mmask16, self.0)
         }
     }
 }

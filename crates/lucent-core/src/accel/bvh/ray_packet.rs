@@ -1,8 +1,11 @@
 //! Packets of coherent rays (camera rays of a tile, shadow rays toward one light) walked
 //! through the wide BVH together, one SIMD lane per ray: eight with AVX2, sixteen with
-//! AVX-512 ([`super::ray_lanes`]). At a node, each child box is tested against every
-//! active ray of the packet; a child that some ray enters is pushed with the mask of
-//! those rays. At a leaf reached by several rays that share their dominant axis, each
+//! AVX-512 ([`super::ray_lanes`]). At a node, when the rays all move the same way along
+//! each axis, the interval test of [`super::packet_frustum`] first drops the children no
+//! ray of the packet can enter (camera rays enter one or two of eight); a closest-hit
+//! packet goes on into the inner nodes it keeps with all its rays. Each other child box
+//! is tested against every active ray of the packet; a child that some ray enters is
+//! pushed with the mask of those rays. At a leaf reached by several rays that share their dominant axis, each
 //! triangle is tested against all of them at once ([`super::ray_triangle`]); otherwise
 //! each ray runs the single-ray four-triangle test. A node is fetched once for the whole
 //! packet, and the lanes' independent work fills the pipeline that one ray's chain of
@@ -16,11 +19,16 @@
 //! hit, against its own closest hit so far and search limit. Both leaf tests compute the
 //! scalar triangle test's bits, accept `t ≤ t_max` and keep ties by primitive index, so
 //! neither the order of visits nor the order of triangles within a leaf can change a
-//! ray's answer. Rays without the fused test's constants (an axis they do not move along,
-//! a constant that is not finite, a negative `t_min`) are traced alone.
+//! ray's answer. The interval test never drops a box the exact slab test has some ray
+//! enter, and its near bound (an inner node's key and entry distance) is at most every
+//! ray's, so it keeps the same guarantee. Rays without the fused test's constants (an
+//! axis they do not move along, a constant that is not finite, a negative `t_min`) are
+//! traced alone.
 
 use super::box_test::FmaOffsets;
+use super::lanes::Lanes as _;
 use super::packet::{LaneKind, Lanes as Bits, Packet};
+use super::packet_frustum::Frustum;
 use super::ray_lanes::RayLanes;
 use super::ray_triangle::{self, ShearedRays};
 use super::traverse::leaf_packets;
@@ -61,6 +69,8 @@ struct PacketLanes<L> {
     boxes: BoxLanes<L>,
     /// For the triangle test, when the rays share their axis permutation.
     sheared: Option<ShearedRays<L>>,
+    /// The rays as intervals, when they all move the same way along every axis.
+    frustum: Option<Frustum>,
     /// The rays that can travel in the packet: those with the fused box test's
     /// constants (no axis they do not move along, every constant finite, `t_min ≥ 0`).
     /// The others are traced alone.
@@ -123,7 +133,9 @@ unsafe fn packet_lanes<L: RayLanes>(rays: &[Ray]) -> PacketLanes<L> {
         }
         _ => None,
     };
+    let frustum = rows.filter(|_| ok != 0).map(|rows| Frustum::new(&o, &inv, rows, ok));
     PacketLanes {
+        frustum,
         boxes: BoxLanes {
             inv,
             near_off,
@@ -368,6 +380,8 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     }
     let mut t_max_lanes = L::load(t_max.as_ptr());
     let mut limit = t_max_lanes.mul(L::splat(SEARCH_SLACK));
+    // The largest search limit of the packet's rays, for the interval test.
+    let mut packet_limit = limit.max_of(live);
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK_SIZE];
     // Each entry's rays' entry distances: a ray that has since found a hit nearer than
     // its entry is dropped from the entry when it is popped.
@@ -428,17 +442,43 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             }
             if Q::SHRINKS {
                 limit = t_max_lanes.mul(L::splat(SEARCH_SLACK));
+                packet_limit = limit.max_of(live);
             }
             continue;
         }
         let node = &*nodes.as_ptr().cast::<u8>().add(e.reference as usize).cast::<WideNode>();
         // The children some active ray enters; for closest-hit queries keyed by the entry
         // distance of the lowest such ray and ordered so that the nearest is popped first
-        // (any-hit queries pop the last slot first, as single rays do).
+        // (any-hit queries pop the last slot first, as single rays do). When the rays
+        // allow it, the interval test first drops the slots no ray can enter.
         let base = sp;
-        for c in 0..WIDTH {
+        let mut bound = [0f32; WIDTH];
+        let slots = match &lanes.frustum {
+            Some(f) => {
+                let (slots, near) = f.children(node, packet_limit);
+                near.store(bound.as_mut_ptr());
+                slots
+            }
+            None => (1 << WIDTH) - 1,
+        };
+        for c in Bits(slots) {
             let child = node.child[c];
             if child == EMPTY {
+                continue;
+            }
+            if Q::SHRINKS && lanes.frustum.is_some() && child & LEAF == 0 {
+                // A closest-hit query takes an inner node the interval test keeps with
+                // all the rays of this one, keyed by the interval's near bound (no ray
+                // enters it nearer, so the bound also drops rays that have found a
+                // nearer hit by the time it is popped); only leaves are worth a test
+                // per ray. (Any-hit packets spread wider, and gained nothing from it.)
+                entry_near[sp].write(L::splat(bound[c]));
+                stack[sp].write(Entry {
+                    reference: child,
+                    rays: mask,
+                    key: bound[c],
+                });
+                sp += 1;
                 continue;
             }
             let (hits, n) = if l.rows.is_some() {
