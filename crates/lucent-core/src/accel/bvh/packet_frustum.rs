@@ -15,9 +15,11 @@
 //! `r`); for rays moving down, `O_lo` takes `O_hi`'s place; the far bound is the same
 //! with the larger product and the other end of the origins. The subtraction and the
 //! product each round once, and `t` differs from `(b − oᵢ)·rᵢ` by the factor `1/(1 + δ)`:
-//! within 4u of the bound in all. Scaling the bounds by `1 ∓ 2⁻²⁰` (16u, itself rounded
-//! once) makes the near bound at most every ray's near distance and the far bound at
-//! least every ray's far distance (for results in the normal range). So whenever the
+//! within 3u of the bound in all. Widening `[R_lo, R_hi]` outward by 2⁻²⁰ of each end
+//! (16u; itself rounded once, and the interval keeps its sign) scales every product's
+//! magnitude up or down by at least that much in the direction that loosens the bound,
+//! so the near bound is at most every ray's near distance and the far bound at least
+//! every ray's far distance (for results in the normal range). So whenever the
 //! exact slab test has some ray enter a child within `[t_min, t_max]` (`t_min ≥ 0`),
 //! the interval test keeps that child: near ≤ far, near ≤ the packet's largest search
 //! limit, far ≥ 0. An empty slot (`+∞` minima, `−∞` maxima) gives near `+∞` and far
@@ -27,7 +29,7 @@ use super::lanes::{Avx, Lanes};
 use super::ray_lanes::RayLanes;
 use super::wide::WideNode;
 
-/// The relative widening of the interval bounds (see the module docs).
+/// The relative widening of the reciprocal directions' interval (see the module docs).
 const MARGIN: f32 = 1.0 / (1u32 << 20) as f32;
 
 /// A packet's rays as intervals, per axis, broadcast over a node's eight children.
@@ -67,8 +69,9 @@ impl Frustum {
             let up = rows[a].0 == a;
             f.near_origin[a] = Avx::splat(if up { o_hi } else { o_lo });
             f.far_origin[a] = Avx::splat(if up { o_lo } else { o_hi });
-            f.inv_lo[a] = Avx::splat(inv[a].min_of(rays));
-            f.inv_hi[a] = Avx::splat(inv[a].max_of(rays));
+            let (r_lo, r_hi) = (inv[a].min_of(rays), inv[a].max_of(rays));
+            f.inv_lo[a] = Avx::splat(r_lo - r_lo.abs() * MARGIN);
+            f.inv_hi[a] = Avx::splat(r_hi + r_hi.abs() * MARGIN);
         }
         f
     }
@@ -86,9 +89,6 @@ impl Frustum {
             near = near.max(dn.mul(self.inv_lo[a]).min(dn.mul(self.inv_hi[a])));
             far = far.min(df.mul(self.inv_lo[a]).max(df.mul(self.inv_hi[a])));
         }
-        let (down, up) = (Avx::splat(1.0 - MARGIN), Avx::splat(1.0 + MARGIN));
-        let near = near.mul(down).min(near.mul(up));
-        let far = far.mul(down).max(far.mul(up));
         let enters = Avx::and(near.le(far), near.le(Avx::splat(limit)));
         (Avx::bits(Avx::and(enters, Avx::splat(0.0).le(far))), near)
     }

@@ -380,8 +380,10 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     }
     let mut t_max_lanes = L::load(t_max.as_ptr());
     let mut limit = t_max_lanes.mul(L::splat(SEARCH_SLACK));
-    // The largest search limit of the packet's rays, for the interval test.
-    let mut packet_limit = limit.max_of(live);
+    // The largest search limit of the packet's rays, for the interval test. Not brought
+    // up to date as hits are found (a reduction across the lanes after every leaf cost
+    // more than it saved): the rays' own limits drop the entries when they are popped.
+    let packet_limit = limit.max_of(live);
     let mut stack = [const { MaybeUninit::<Entry>::uninit() }; STACK_SIZE];
     // Each entry's rays' entry distances: a ray that has since found a hit nearer than
     // its entry is dropped from the entry when it is popped.
@@ -442,7 +444,6 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             }
             if Q::SHRINKS {
                 limit = t_max_lanes.mul(L::splat(SEARCH_SLACK));
-                packet_limit = limit.max_of(live);
             }
             continue;
         }
