@@ -143,10 +143,12 @@ impl QuadLight {
         let r2 = to_light.length_squared();
         let distance = r2.sqrt();
         let wi = to_light / distance;
-        let cos_light = self.normal.dot(wi);
-        // Density by area 1/A, in solid angle r² / (A cos θ_light).
-        let pdf = r2 / (self.area * cos_light);
-        (cos_light > 0.0 && pdf.is_finite()).then_some(LightSample {
+        // Density by area 1/A, in solid angle r² / (A cos θ_light) = r³ / (A n·(y − x)):
+        // `n·(y − x)` is made beside the square root, not after the division by it (a
+        // chain of square root, division, dot product and division before the density).
+        let cos_times_distance = self.normal.dot(to_light);
+        let pdf = r2 * distance / (self.area * cos_times_distance);
+        (cos_times_distance > 0.0 && pdf.is_finite()).then_some(LightSample {
             wi,
             distance,
             radiance: self.radiance,
