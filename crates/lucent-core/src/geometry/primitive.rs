@@ -154,17 +154,20 @@ impl Primitive {
             _ => {}
         }
         let barycentric = Vec2::new(hit.b1, hit.b2);
-        // (point, its error bound, geometric normal, shading normal, uv)
+        // (point, its error bound, geometric normal, shading normal, uv); the geometric
+        // normal is turned to the shading normal's side (only interpolated normals can
+        // differ from it: the other shapes give the same vector twice, and skip the test).
         let (point, error, ng, normal, uv) = match &self.shape {
             Shape::Triangle { p, normals } => {
                 let (point, error) = spawn::barycentric_point(*p, hit.b1, hit.b2);
                 let ng = triangle::geometric_normal(p[0], p[1], p[2]);
-                let normal = match normals {
-                    None => ng,
+                let (ng, normal) = match normals {
+                    None => (ng, ng),
                     Some(i) => {
                         let n = &vertex_normals[*i as usize];
                         let b0 = 1.0 - hit.b1 - hit.b2;
-                        (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize()
+                        let normal = (n[0] * b0 + n[1] * hit.b1 + n[2] * hit.b2).normalize();
+                        (if ng.dot(normal) < 0.0 { -ng } else { ng }, normal)
                     }
                 };
                 (point, error, ng, normal, barycentric)
@@ -198,7 +201,7 @@ impl Primitive {
         SurfacePoint {
             point,
             error,
-            geometric_normal: if ng.dot(normal) < 0.0 { -ng } else { ng },
+            geometric_normal: ng,
             normal,
             uv,
             material: self.material,

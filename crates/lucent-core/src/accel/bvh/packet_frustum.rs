@@ -97,7 +97,7 @@ impl Frustum {
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::super::box_test::tests::exact_entry;
-    use super::super::ray_lanes::Rays8;
+    use super::super::ray_lanes::{Rays16, Rays8};
     use super::super::wide::WIDTH;
     use super::*;
     use crate::accel::search_limit;
@@ -151,37 +151,48 @@ mod tests {
         (node, rays)
     }
 
+    /// The slots the interval test keeps for `rays` (at most eight) and their near
+    /// bounds, with the rays' fields in lanes of `L`.
+    ///
+    /// # Safety
+    /// The CPU must run `L`'s instructions.
+    unsafe fn interval_test<L: RayLanes>(node: &WideNode, rays: &[Ray], limit: f32) -> (u32, [f32; WIDTH]) {
+        let lane = |f: &dyn Fn(&Ray) -> f32| {
+            let mut v = [0f32; 16];
+            for (i, r) in rays.iter().enumerate() {
+                v[i] = f(r);
+            }
+            L::load(v.as_ptr())
+        };
+        let origin = [0, 1, 2].map(|a| lane(&|r: &Ray| r.origin[a]));
+        let inv = [0, 1, 2].map(|a| lane(&|r: &Ray| 1.0 / r.dir[a]));
+        let rows = [0, 1, 2].map(|a| if rays[0].dir[a] > 0.0 { (a, a + 3) } else { (a + 3, a) });
+        let f = Frustum::new(&origin, &inv, rows, (1 << rays.len()) - 1);
+        let (mask, near) = f.children(node, limit);
+        let mut bound = [0f32; WIDTH];
+        near.store(bound.as_mut_ptr());
+        (mask, bound)
+    }
+
     #[test]
     fn the_interval_test_keeps_every_box_a_ray_of_the_packet_enters() {
         if !super::super::Isa::detect().has_avx2() {
             eprintln!("note: no AVX2 and FMA here, the interval test was not checked");
             return;
         }
+        let avx512 = super::super::Isa::detect() == super::super::Isa::Avx512;
         let mut rng = Rng(97);
         let (mut entered, mut dropped) = (0u32, 0u32);
         for _ in 0..20_000 {
             let (node, rays) = case(&mut rng);
-            let n = rays.len();
-            let lane = |f: &dyn Fn(&Ray) -> f32| {
-                let mut v = [0f32; 8];
-                for (i, r) in rays.iter().enumerate() {
-                    v[i] = f(r);
-                }
-                // SAFETY: AVX2 checked above; `v` holds eight floats.
-                unsafe { Rays8::load(v.as_ptr()) }
-            };
-            let origin = [0, 1, 2].map(|a| lane(&|r: &Ray| r.origin[a]));
-            let inv = [0, 1, 2].map(|a| lane(&|r: &Ray| 1.0 / r.dir[a]));
-            let rows = [0, 1, 2].map(|a| if rays[0].dir[a] > 0.0 { (a, a + 3) } else { (a + 3, a) });
             for t_max in [f32::INFINITY, 1e3 * rng.next()] {
-                // SAFETY: AVX2 checked above.
-                let (mask, near) = unsafe {
-                    let f = Frustum::new(&origin, &inv, rows, (1 << n) - 1);
-                    let (mask, near) = f.children(&node, search_limit(t_max));
-                    let mut bound = [0f32; WIDTH];
-                    near.store(bound.as_mut_ptr());
-                    (mask, bound)
-                };
+                // SAFETY: AVX2 checked above, AVX-512 where it is used.
+                let (mask, near) = unsafe { interval_test::<Rays8>(&node, &rays, search_limit(t_max)) };
+                if avx512 {
+                    // The sixteen-lane packets' reductions find the same intervals.
+                    let wide = unsafe { interval_test::<Rays16>(&node, &rays, search_limit(t_max)) };
+                    assert_eq!((mask, near), wide);
+                }
                 for slot in 0..WIDTH {
                     let lo = [0, 1, 2].map(|a| node.bounds[a][slot]);
                     let hi = [0, 1, 2].map(|a| node.bounds[a + 3][slot]);
