@@ -110,9 +110,10 @@ fn one_ulp_toward(m: f32, o: f32) -> f32 {
 }
 
 /// [`one_ulp_along`] without a branch: the sign of each offset component follows the
-/// surface's normal, which no branch predictor foresees (two in every ray spawned were a
-/// fifth of a path tracer's mispredicted branches). The same bits as [`next_up`] and
-/// [`next_down`] (a test compares them on every kind of float).
+/// surface's normal, which no branch predictor foresees (the per-component branches were
+/// a fifth of a path-traced Cornell box's mispredictions in callgrind's simulation). The
+/// same bits as [`next_up`] and [`next_down`] (a test compares them on every kind of
+/// float).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn one_ulp_along_sse2(m: Vec3A, o: Vec3A) -> Vec3A {
