@@ -5,9 +5,9 @@
 //! ray of the packet can enter (camera rays enter one or two of eight); a closest-hit
 //! packet goes on into the inner nodes it keeps with all its rays. Each other child box
 //! is tested against every active ray of the packet; a child that some ray enters is
-//! pushed with the mask of those rays. At a leaf reached by several rays that share their dominant axis, each
-//! triangle is tested against all of them at once ([`super::ray_triangle`]); otherwise
-//! each ray runs the single-ray four-triangle test. A node is fetched once for the whole
+//! pushed with the mask of those rays. At a leaf reached by several rays that share
+//! their dominant axis, each triangle is tested against all of them at once
+//! ([`super::ray_triangle`]); otherwise each ray runs the single-ray four-triangle test. A node is fetched once for the whole
 //! packet, and the lanes' independent work fills the pipeline that one ray's chain of
 //! dependent loads leaves idle.
 //!
