@@ -7,9 +7,9 @@
 //! is tested against every active ray of the packet; a child that some ray enters is
 //! pushed with the mask of those rays. At a leaf reached by several rays that share
 //! their dominant axis, each triangle is tested against all of them at once
-//! ([`super::ray_triangle`]); otherwise each ray runs the single-ray four-triangle test. A node is fetched once for the whole
-//! packet, and the lanes' independent work fills the pipeline that one ray's chain of
-//! dependent loads leaves idle.
+//! ([`super::ray_triangle`]); otherwise each ray runs the single-ray four-triangle test.
+//! A node is fetched once for the whole packet, and the lanes' independent work fills
+//! the pipeline that one ray's chain of dependent loads leaves idle.
 //!
 //! **The same answers.** Each ray's box test is the fused test of [`super::traverse`]
 //! (`plane · (1/d) − o/d` with the offsets of [`FmaOffsets`]), which never rejects a box
