@@ -36,9 +36,9 @@ pub const SHALLOW_STACK: usize = stack_entries(SHALLOW_LEVELS);
 pub const DEEP_STACK: usize = stack_entries(MAX_LEVELS);
 
 /// Asks for the first cache lines of a child that was pushed on the stack: by the time
-/// it is popped, after the nearer subtree, they have arrived.
+/// it is popped, after the nearer subtree, they have arrived (single rays and packets).
 #[inline(always)]
-unsafe fn prefetch(nodes: &[WideNode], packets: &[Packet], reference: u32) {
+pub(super) unsafe fn prefetch(nodes: &[WideNode], packets: &[Packet], reference: u32) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
