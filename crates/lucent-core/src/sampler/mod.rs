@@ -49,6 +49,9 @@ pub struct Sampler {
     /// Sobol: the sample's index in the pixel's sequences, its bits reversed (the order
     /// the scrambles work in); `None` for independent numbers.
     sobol_index: Option<u32>,
+    /// Sobol: the next draw's numbers, made one draw ahead (see [`Sampler::uniform2`]);
+    /// `dimension` counts it.
+    ahead: (f32, f32),
 }
 
 /// SplitMix64's finaliser: a bijection of u64 with good avalanche.
@@ -66,11 +69,15 @@ impl Sampler {
             SamplerKind::Independent => Sampler::new(seed, x, y, sample),
             SamplerKind::Sobol => {
                 let pixel = (y as u64) << 32 | x as u64;
-                Sampler {
+                let index = sample.reverse_bits();
+                let mut s = Sampler {
                     key: mix(pixel ^ 0x5851_f42d_4c95_7f2d) ^ mix(seed),
                     dimension: 0,
-                    sobol_index: Some(sample.reverse_bits()),
-                }
+                    sobol_index: Some(index),
+                    ahead: (0.0, 0.0),
+                };
+                s.ahead = sobol::sample2(index, s.next_seeds());
+                s
             }
         }
     }
@@ -83,6 +90,7 @@ impl Sampler {
             key: mix(mix(pixel) ^ (sample as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)) ^ mix(seed),
             dimension: 0,
             sobol_index: None,
+            ahead: (0.0, 0.0),
         }
     }
 
@@ -109,7 +117,8 @@ impl Sampler {
     #[inline(always)]
     pub fn uniform(&mut self) -> f32 {
         match self.sobol_index {
-            Some(i) => sobol::sample1(i, self.next_seeds()),
+            // A draw of one number is the first of a two-number draw's.
+            Some(_) => self.uniform2().0,
             // 24 random bits: every value is exactly representable and below 1.
             None => (self.next_draw() >> 40) as f32 * (1.0 / (1u64 << 24) as f32),
         }
@@ -120,7 +129,13 @@ impl Sampler {
     #[inline(always)]
     pub fn uniform2(&mut self) -> (f32, f32) {
         match self.sobol_index {
-            Some(i) => sobol::sample2(i, self.next_seeds()),
+            // The draw made ahead, and the next one made now: its chain of hashes does
+            // not depend on the path, so the CPU works on it while the path's own chain
+            // waits (rather than when the path asks for it).
+            Some(i) => {
+                let next = sobol::sample2(i, self.next_seeds());
+                std::mem::replace(&mut self.ahead, next)
+            }
             None => (self.uniform(), self.uniform()),
         }
     }
@@ -218,6 +233,27 @@ mod tests {
             Sampler::new(3, 1, 2, 7),
         );
         assert_eq!(a.uniform2(), b.uniform2());
+    }
+
+    #[test]
+    fn sobol_draws_made_ahead_are_each_dimensions_own() {
+        // Draw d of a sample is point `sample` of sequence d (its first number, for a
+        // draw of one), whatever was drawn before it: the numbers made one draw ahead
+        // are the ones a sampler computing each dimension when asked gives.
+        for sample in [0u32, 1, 7, 300] {
+            let mut s = Sampler::start(SamplerKind::Sobol, 5, 3, 4, sample);
+            let mut direct = s.clone();
+            direct.dimension = 0;
+            let i = sample.reverse_bits();
+            for d in 0..12 {
+                let want = sobol::sample2(i, direct.next_seeds());
+                if d % 3 == 1 {
+                    assert_eq!(s.uniform(), want.0, "sample {sample}, draw {d}");
+                } else {
+                    assert_eq!(s.uniform2(), want, "sample {sample}, draw {d}");
+                }
+            }
+        }
     }
 
     #[test]

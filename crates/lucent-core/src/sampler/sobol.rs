@@ -104,21 +104,14 @@ fn shuffled(i_reversed: u32, seed: u32) -> u32 {
     scramble_reversed(i_reversed, seed).reverse_bits()
 }
 
-/// The point of index `i_reversed.reverse_bits()` in the one-dimensional scrambled Sobol
-/// (van der Corput) sequence picked by `seeds` (its `y` is not used). The index comes
-/// reversed because the sampler reverses it once for all its draws.
-#[inline(always)]
-pub fn sample1(i_reversed: u32, seeds: Seeds) -> f32 {
-    // Dimension 0 is the index with its bits reversed: in reversed order, the index itself.
-    let s = shuffled(i_reversed, seeds.index);
-    to_unit(scramble_reversed(s, seeds.x).reverse_bits())
-}
-
 /// The point of index `i_reversed.reverse_bits()` in the two-dimensional scrambled Sobol
-/// sequence picked by `seeds`.
+/// sequence picked by `seeds`. The index comes reversed because the sampler reverses it
+/// once for all its draws. Its first number alone is the point of the one-dimensional
+/// scrambled Sobol (van der Corput) sequence: what the sampler draws one number from.
 #[inline(always)]
 pub fn sample2(i_reversed: u32, seeds: Seeds) -> (f32, f32) {
     let s = shuffled(i_reversed, seeds.index);
+    // Dimension 0 is the index with its bits reversed: in reversed order, the index itself.
     let x = scramble_reversed(s, seeds.x);
     let y = scramble_reversed(sobol_dimension_1_reversed(s), seeds.y);
     let (x, y) = reverse_both(x, y);
@@ -194,7 +187,7 @@ mod tests {
             // In one dimension: one point in each of the 2ᵏ intervals.
             let mut seen = [false; 64];
             for i in 64..128 {
-                let c = (sample1(u32::reverse_bits(i), seeds(seed)) * 64.0) as usize;
+                let c = (sample2(u32::reverse_bits(i), seeds(seed)).0 * 64.0) as usize;
                 assert!(!std::mem::replace(&mut seen[c], true), "seed {seed}");
             }
         }
