@@ -224,8 +224,8 @@ trait Query<P: PrimitiveSet + ?Sized> {
     type Answer;
     const NONE: Self::Answer;
     /// Whether the query runs compiled for AVX-512 on CPUs that have it ([`run_avx512`]).
-    /// Measured on an AMD EPYC (Zen 4): closest hits 1.06–1.08× faster, any-hit queries
-    /// not (0.97–1.01×), so they keep the AVX2 code.
+    /// Measured on an AMD EPYC (Zen 4): closest hits 1.05–1.11× faster, any-hit queries
+    /// not (0.93–1.01×), so they keep the AVX2 code.
     const AVX512: bool;
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
@@ -376,6 +376,7 @@ impl Bvh {
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx512 if Q::AVX512 => run_avx512::<Q, P>(self, prims, r),
+                #[cfg(target_arch = "x86_64")]
                 Isa::Avx512 | Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
                 _ => run_portable::<Q, P>(self, prims, r),
             }
