@@ -40,7 +40,7 @@ use wide::WideNode;
 pub enum Isa {
     /// AVX-512 F, VL and BW (with AVX2 and FMA): packets of sixteen rays; single rays
     /// take the 8-wide AVX2 code, compiled for AVX-512 for closest hits (see
-    /// [`Query::AVX512`]).
+    /// `Query::AVX512`).
     Avx512,
     /// AVX2 with FMA (every AVX2 CPU has both): packets of eight rays.
     Avx2,
