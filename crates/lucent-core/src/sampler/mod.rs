@@ -17,6 +17,9 @@
 //!   default.
 
 pub mod sobol;
+pub mod sobol_block;
+
+use sobol_block::{Block, BLOCK};
 
 /// Where a sampler's numbers come from (`sampler independent|sobol`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,9 +52,9 @@ pub struct Sampler {
     /// Sobol: the sample's index in the pixel's sequences, its bits reversed (the order
     /// the scrambles work in); `None` for independent numbers.
     sobol_index: Option<u32>,
-    /// Sobol: the next draw's numbers, made one draw ahead (see [`Sampler::uniform2`]);
-    /// `dimension` counts it.
-    ahead: (f32, f32),
+    /// Sobol: the numbers of the block of [`BLOCK`] draws that the last draw belongs to,
+    /// made together when its first draw was asked for ([`sobol_block`]).
+    block: Block,
 }
 
 /// SplitMix64's finaliser: a bijection of u64 with good avalanche.
@@ -70,14 +73,12 @@ impl Sampler {
             SamplerKind::Sobol => {
                 let pixel = (y as u64) << 32 | x as u64;
                 let index = sample.reverse_bits();
-                let mut s = Sampler {
+                Sampler {
                     key: mix(pixel ^ 0x5851_f42d_4c95_7f2d) ^ mix(seed),
                     dimension: 0,
                     sobol_index: Some(index),
-                    ahead: (0.0, 0.0),
-                };
-                s.ahead = sobol::sample2(index, s.next_seeds());
-                s
+                    block: Block::default(),
+                }
             }
         }
     }
@@ -90,7 +91,7 @@ impl Sampler {
             key: mix(mix(pixel) ^ (sample as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)) ^ mix(seed),
             dimension: 0,
             sobol_index: None,
-            ahead: (0.0, 0.0),
+            block: Block::default(),
         }
     }
 
@@ -98,19 +99,7 @@ impl Sampler {
     #[inline]
     fn next_draw(&mut self) -> u64 {
         self.dimension += 1;
-        mix(self.key ^ self.dimension.wrapping_mul(0xd1b5_4a32_d192_ed03))
-    }
-
-    /// The scrambles of the next draw's Sobol sequence, cut from one 64-bit hash.
-    #[inline]
-    fn next_seeds(&mut self) -> sobol::Seeds {
-        let h = self.next_draw();
-        sobol::Seeds {
-            index: h as u32,
-            x: (h >> 32) as u32,
-            // The middle bits, turned: as well mixed as the others, and not equal to either.
-            y: ((h >> 16) as u32).rotate_left(7) ^ 0x9e37_79b9,
-        }
+        sobol_block::draw_hash(self.key, self.dimension)
     }
 
     /// The next number, uniform in [0, 1).
@@ -129,12 +118,15 @@ impl Sampler {
     #[inline(always)]
     pub fn uniform2(&mut self) -> (f32, f32) {
         match self.sobol_index {
-            // The draw made ahead, and the next one made now: its chain of hashes does
-            // not depend on the path, so the CPU works on it while the path's own chain
-            // waits (rather than when the path asks for it).
+            // Draws come in blocks made together (their numbers do not depend on the
+            // path, so they can be made before it asks for them).
             Some(i) => {
-                let next = sobol::sample2(i, self.next_seeds());
-                std::mem::replace(&mut self.ahead, next)
+                let slot = (self.dimension % BLOCK as u64) as usize;
+                if slot == 0 {
+                    self.block = sobol_block::draws(self.key, self.dimension + 1, i);
+                }
+                self.dimension += 1;
+                (self.block.x[slot], self.block.y[slot])
             }
             None => (self.uniform(), self.uniform()),
         }
@@ -236,17 +228,16 @@ mod tests {
     }
 
     #[test]
-    fn sobol_draws_made_ahead_are_each_dimensions_own() {
+    fn sobol_draws_made_in_blocks_are_each_dimensions_own() {
         // Draw d of a sample is point `sample` of sequence d (its first number, for a
-        // draw of one), whatever was drawn before it: the numbers made one draw ahead
-        // are the ones a sampler computing each dimension when asked gives.
+        // draw of one), whatever was drawn before it: the numbers made in blocks are the
+        // ones a sampler computing each dimension when asked gives.
         for sample in [0u32, 1, 7, 300] {
             let mut s = Sampler::start(SamplerKind::Sobol, 5, 3, 4, sample);
             let mut direct = s.clone();
-            direct.dimension = 0;
             let i = sample.reverse_bits();
-            for d in 0..12 {
-                let want = sobol::sample2(i, direct.next_seeds());
+            for d in 0..3 * BLOCK + 3 {
+                let want = sobol::sample2(i, sobol_block::seeds(direct.next_draw()));
                 if d % 3 == 1 {
                     assert_eq!(s.uniform(), want.0, "sample {sample}, draw {d}");
                 } else {

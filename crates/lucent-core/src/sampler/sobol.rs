@@ -20,14 +20,19 @@
 /// bits and the seed, which is what Owen scrambling asks.
 #[inline(always)]
 fn scramble_reversed(mut x: u32, seed: u32) -> u32 {
+    let [c0, c1, c2] = SCRAMBLE_CONSTANTS;
     // Multiplying and adding carry only upwards: lower bits decide higher ones.
-    x ^= x.wrapping_mul(0x3d20_adea);
+    x ^= x.wrapping_mul(c0);
     x = x.wrapping_add(seed);
     x = x.wrapping_mul((seed >> 16) | 1);
-    x ^= x.wrapping_mul(0x0552_6c56);
-    x ^= x.wrapping_mul(0x53a2_2864);
+    x ^= x.wrapping_mul(c1);
+    x ^= x.wrapping_mul(c2);
     x
 }
+
+/// The multipliers of [`scramble_reversed`] (shared with the vector code of
+/// [`super::sobol_block`]).
+pub(super) const SCRAMBLE_CONSTANTS: [u32; 3] = [0x3d20_adea, 0x0552_6c56, 0x53a2_2864];
 
 /// The direction numbers of Sobol's second dimension as 32-bit binary fractions: the
 /// columns of the Pascal matrix mod 2 (v₀ = ½, vₖ = vₖ₋₁ ⊕ vₖ₋₁/2).
@@ -73,12 +78,30 @@ static DIMENSION_1: [[u32; 256]; 4] = byte_tables();
 /// Sobol's second dimension of point `i`, as a 32-bit binary fraction with its bits
 /// reversed.
 #[inline(always)]
-fn sobol_dimension_1_reversed(i: u32) -> u32 {
+pub(super) fn sobol_dimension_1_reversed(i: u32) -> u32 {
     let t = &DIMENSION_1;
     t[0][(i & 0xff) as usize]
         ^ t[1][(i >> 8 & 0xff) as usize]
         ^ t[2][(i >> 16 & 0xff) as usize]
         ^ t[3][(i >> 24) as usize]
+}
+
+/// The positions j whose bit t is clear, for t = 0..5: with them
+/// [`sobol_dimension_1_reversed`] needs no tables (for vector code, which has no cheap
+/// table lookup). Reversed, direction number k is row k of Pascal's triangle mod 2: bit j
+/// is set when j's bits are a subset of k's (Lucas). So bit j of the result is the
+/// parity of the set bits of the index at the positions k ⊇ j: a sum over supersets,
+/// made one bit of the position at a time (at step t, each position j without bit t
+/// adds position j + 2ᵗ: `i ^= (i >> 2ᵗ) & SUBSET_MASKS[t]`).
+pub(super) const SUBSET_MASKS: [u32; 5] = [0x5555_5555, 0x3333_3333, 0x0f0f_0f0f, 0x00ff_00ff, 0x0000_ffff];
+
+/// [`sobol_dimension_1_reversed`] by [`SUBSET_MASKS`], one lane of the vector code.
+#[cfg(test)]
+fn dimension_1_by_subsets(mut i: u32) -> u32 {
+    for (t, mask) in SUBSET_MASKS.iter().enumerate() {
+        i ^= (i >> (1 << t)) & mask;
+    }
+    i
 }
 
 /// A 32-bit binary fraction as a float in [0, 1): its 24 leading bits, exactly.
@@ -137,6 +160,18 @@ mod tests {
             x = x.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
             let y = x.rotate_left(13) ^ 0xdead_beef;
             assert_eq!(reverse_both(x, y), (x.reverse_bits(), y.reverse_bits()));
+        }
+    }
+
+    #[test]
+    fn the_second_dimension_by_subsets_is_the_tables() {
+        let mut i = 0u32;
+        for n in 0..100_000u32 {
+            assert_eq!(dimension_1_by_subsets(i), sobol_dimension_1_reversed(i), "index {i:#x}");
+            i = i.wrapping_mul(0x2c1b_3c6d).wrapping_add(n | 1);
+        }
+        for i in [0, 1, u32::MAX, 1 << 31, 0xffff, 0xffff_0000] {
+            assert_eq!(dimension_1_by_subsets(i), sobol_dimension_1_reversed(i), "index {i:#x}");
         }
     }
 
