@@ -60,10 +60,14 @@ pub struct Sampler {
 /// SplitMix64's finaliser: a bijection of u64 with good avalanche.
 #[inline(always)]
 fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    let [m1, m2] = MIX_MULTIPLIERS;
+    z = (z ^ (z >> 30)).wrapping_mul(m1);
+    z = (z ^ (z >> 27)).wrapping_mul(m2);
     z ^ (z >> 31)
 }
+
+/// [`mix`]'s multipliers (shared with the vector code of [`sobol_block`]).
+const MIX_MULTIPLIERS: [u64; 2] = [0xbf58_476d_1ce4_e5b9, 0x94d0_49bb_1331_11eb];
 
 impl Sampler {
     /// Sample `sample` of pixel (x, y), with numbers of the given kind.

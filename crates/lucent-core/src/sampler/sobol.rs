@@ -93,6 +93,7 @@ pub(super) fn sobol_dimension_1_reversed(i: u32) -> u32 {
 /// parity of the set bits of the index at the positions k ⊇ j: a sum over supersets,
 /// made one bit of the position at a time (at step t, each position j without bit t
 /// adds position j + 2ᵗ: `i ^= (i >> 2ᵗ) & SUBSET_MASKS[t]`).
+#[cfg_attr(not(any(test, target_arch = "x86_64")), allow(dead_code))]
 pub(super) const SUBSET_MASKS: [u32; 5] = [0x5555_5555, 0x3333_3333, 0x0f0f_0f0f, 0x00ff_00ff, 0x0000_ffff];
 
 /// [`sobol_dimension_1_reversed`] by [`SUBSET_MASKS`], one lane of the vector code.

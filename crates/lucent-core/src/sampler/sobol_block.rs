@@ -94,9 +94,11 @@ unsafe fn draws_avx2(key: u64, first_dimension: u64, i_reversed: u32) -> Block {
         );
         _mm256_add_epi64(lo, _mm256_slli_epi64::<32>(cross))
     };
+    // `super::mix` (the same shifts and multipliers).
+    let [m1, m2] = super::MIX_MULTIPLIERS;
     let mix = |mut z: __m256i| -> __m256i {
-        z = mul64(_mm256_xor_si256(z, _mm256_srli_epi64::<30>(z)), MIX_1);
-        z = mul64(_mm256_xor_si256(z, _mm256_srli_epi64::<27>(z)), MIX_2);
+        z = mul64(_mm256_xor_si256(z, _mm256_srli_epi64::<30>(z)), m1);
+        z = mul64(_mm256_xor_si256(z, _mm256_srli_epi64::<27>(z)), m2);
         _mm256_xor_si256(z, _mm256_srli_epi64::<31>(z))
     };
     // The hashes of draws 0–3 and 4–7: `dimension · step` as the first one's product plus
@@ -141,9 +143,6 @@ unsafe fn draws_avx2(key: u64, first_dimension: u64, i_reversed: u32) -> Block {
     _mm256_storeu_ps(b.y.as_mut_ptr(), to_unit(y));
     b
 }
-
-const MIX_1: u64 = 0xbf58_476d_1ce4_e5b9;
-const MIX_2: u64 = 0x94d0_49bb_1331_11eb;
 
 /// [`sobol::scramble_reversed`] in each lane.
 #[cfg(target_arch = "x86_64")]
