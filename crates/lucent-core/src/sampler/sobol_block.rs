@@ -63,7 +63,10 @@ pub fn draws(key: u64, first_dimension: u64, i_reversed: u32) -> Block {
 pub fn draws_scalar(key: u64, first_dimension: u64, i_reversed: u32) -> Block {
     let mut b = Block::default();
     for k in 0..BLOCK {
-        let (x, y) = sobol::sample2(i_reversed, seeds(draw_hash(key, first_dimension + k as u64)));
+        let (x, y) = sobol::sample2(
+            i_reversed,
+            seeds(draw_hash(key, first_dimension.wrapping_add(k as u64))),
+        );
         b.x[k] = x;
         b.y[k] = y;
     }
@@ -258,8 +261,9 @@ mod tests {
                 "key {key:#x}, dimension {dimension}"
             );
         }
-        // Dimensions whose products wrap around 2⁶⁴, and the extreme keys.
-        for (key, dimension) in [(0, 1), (u64::MAX, u64::MAX - 9), (1 << 63, 1 << 40)] {
+        // Dimensions whose products wrap around 2⁶⁴ (the last block's count itself wraps),
+        // and the extreme keys.
+        for (key, dimension) in [(0, 1), (u64::MAX, u64::MAX - 9), (1 << 63, 1 << 40), (7, u64::MAX - 3)] {
             assert_eq!(draws(key, dimension, 5), draws_scalar(key, dimension, 5));
         }
     }
