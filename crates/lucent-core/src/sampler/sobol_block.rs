@@ -169,51 +169,14 @@ unsafe fn scramble(mut x: std::arch::x86_64::__m256i, seed: std::arch::x86_64::_
 #[inline]
 unsafe fn reverse_bits(v: std::arch::x86_64::__m256i) -> std::arch::x86_64::__m256i {
     use std::arch::x86_64::*;
-    let bytes = _mm256_shuffle_epi8(
-        v,
-        _mm256_setr_epi8(
-            3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12,
-        ),
-    );
-    // Nibble n reversed (as the high nibble, and as the low one).
-    let rev_high = _mm256_setr_epi8(
-        0x00,
-        0x80u8 as i8,
-        0x40,
-        0xc0u8 as i8,
-        0x20,
-        0xa0u8 as i8,
-        0x60,
-        0xe0u8 as i8,
-        0x10,
-        0x90u8 as i8,
-        0x50,
-        0xd0u8 as i8,
-        0x30,
-        0xb0u8 as i8,
-        0x70,
-        0xf0u8 as i8,
-        0x00,
-        0x80u8 as i8,
-        0x40,
-        0xc0u8 as i8,
-        0x20,
-        0xa0u8 as i8,
-        0x60,
-        0xe0u8 as i8,
-        0x10,
-        0x90u8 as i8,
-        0x50,
-        0xd0u8 as i8,
-        0x30,
-        0xb0u8 as i8,
-        0x70,
-        0xf0u8 as i8,
-    );
-    let rev_low = _mm256_setr_epi8(
-        0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf, 0x0, 0x8, 0x4, 0xc, 0x2, 0xa,
-        0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
-    );
+    // A 16-byte table in both halves (byte shuffles stay within their half).
+    let table = |bytes: [u8; 16]| _mm256_broadcastsi128_si256(_mm_loadu_si128(bytes.as_ptr().cast()));
+    let bytes = _mm256_shuffle_epi8(v, table([3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12]));
+    // Nibble n reversed, as the low nibble and (shifted up) as the high one.
+    let rev_low = table([
+        0x0, 0x8, 0x4, 0xc, 0x2, 0xa, 0x6, 0xe, 0x1, 0x9, 0x5, 0xd, 0x3, 0xb, 0x7, 0xf,
+    ]);
+    let rev_high = _mm256_slli_epi16::<4>(rev_low);
     let nibble = _mm256_set1_epi8(0x0f);
     let low = _mm256_and_si256(bytes, nibble);
     let high = _mm256_and_si256(_mm256_srli_epi16::<4>(bytes), nibble);
