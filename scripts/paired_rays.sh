@@ -11,8 +11,9 @@
 #      `bench rays --reps`, whose rate is the median over the passes), THREADS (default 1)
 #
 # Prints the median of the per-round ratios B/A of Mrays/s (above 1: B is faster) with its
-# quartiles, and each binary's median rate.
+# quartiles, and each binary's median and highest rate.
 set -eu
+. "$(dirname "$0")/paired_common.sh"
 usage="usage: paired_rays.sh MESH.obj RAYS BINARY_A BINARY_B [bench rays options ...]"
 mesh=${1:?$usage}
 rays=${2:?$usage}
@@ -32,23 +33,10 @@ rate() {
     esac
 }
 
+options=("$@")
+measure() { rate "$1" "${options[@]}"; }
+
 pairs=$(mktemp)
 trap 'rm -f "$pairs"' EXIT
-for r in $(seq "$rounds"); do
-    if [ $((r % 2)) = 0 ]; then
-        ra=$(rate "$a" "$@"); rb=$(rate "$b" "$@")
-    else
-        rb=$(rate "$b" "$@"); ra=$(rate "$a" "$@")
-    fi
-    echo "$ra $rb" >> "$pairs"
-done
-
-python3 - "$pairs" "$rays" <<'PY'
-import statistics, sys
-rows = [tuple(map(float, l.split())) for l in open(sys.argv[1]) if l.strip()]
-ratios = sorted(b / a for a, b in rows)
-n = len(ratios)
-q1, q3 = ratios[n // 4], ratios[(3 * n) // 4]
-print(f"{sys.argv[2]}: B/A median {statistics.median(ratios):.3f} [quartiles {q1:.3f}-{q3:.3f}], {n} rounds")
-print(f"  A median {statistics.median(r[0] for r in rows):.2f} Mrays/s, B median {statistics.median(r[1] for r in rows):.2f}")
-PY
+paired_rounds "$rounds" measure "$a" "$b" > "$pairs"
+paired_summary "$pairs" "$rays" higher Mrays/s

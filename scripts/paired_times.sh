@@ -10,6 +10,7 @@
 # Prints the median of the per-round ratios A/B (above 1: B is faster) with its quartiles,
 # and each binary's median and least render_s.
 set -eu
+. "$(dirname "$0")/paired_common.sh"
 scene=${1:?usage: paired_times.sh SCENE.test BINARY_A BINARY_B}
 a=${2:?usage: paired_times.sh SCENE.test BINARY_A BINARY_B}
 b=${3:?usage: paired_times.sh SCENE.test BINARY_A BINARY_B}
@@ -28,24 +29,5 @@ render_s() {
 
 pairs=$(mktemp)
 trap 'rm -f "$pairs"' EXIT
-for r in $(seq "$rounds"); do
-    if [ $((r % 2)) = 0 ]; then
-        ta=$(render_s "$a"); tb=$(render_s "$b")
-    else
-        tb=$(render_s "$b"); ta=$(render_s "$a")
-    fi
-    echo "$ta $tb" >> "$pairs"
-done
-
-python3 - "$pairs" "$scene" <<'PY'
-import statistics, sys
-rows = [tuple(map(float, l.split())) for l in open(sys.argv[1]) if l.strip()]
-ratios = sorted(a / b for a, b in rows)
-n = len(ratios)
-q1, q3 = ratios[n // 4], ratios[(3 * n) // 4]
-a = [r[0] for r in rows]
-b = [r[1] for r in rows]
-print(f"{sys.argv[2]}: A/B median {statistics.median(ratios):.3f} [quartiles {q1:.3f}-{q3:.3f}], {n} rounds")
-print(f"  A median {statistics.median(a):.4f} s, least {min(a):.4f} s")
-print(f"  B median {statistics.median(b):.4f} s, least {min(b):.4f} s")
-PY
+paired_rounds "$rounds" render_s "$a" "$b" > "$pairs"
+paired_summary "$pairs" "$scene" lower s
