@@ -36,6 +36,9 @@ pub struct Scene {
     /// The Monte Carlo integrators' environment light (`envmap`), unless it is black.
     pub environment_light: Option<EnvironmentLight>,
     accel_kind: AccelKind,
+    /// See [`Scene::lambertian_and_quad_lit`] (found once: a mesh brings a material per
+    /// face).
+    lambertian_and_quad_lit: bool,
 }
 
 /// Everything a [`Scene`] is made of, before its acceleration structure is built.
@@ -72,7 +75,14 @@ impl Scene {
                 unsampled: Vec::new(),
             }
         };
+        let lambertian_and_quad_lit = environment.is_none()
+            && found.light.is_none()
+            && found.unsampled.is_empty()
+            && !lights.is_empty()
+            && lights.iter().all(|l| matches!(l, Light::Quad(_)))
+            && materials.iter().all(Material::is_lambertian);
         Scene {
+            lambertian_and_quad_lit,
             camera,
             geometry: Geometry::new(primitives, vertex_normals, accel),
             accel_kind: accel,
@@ -87,6 +97,15 @@ impl Scene {
             emitters: found.light,
             unsampled_emitters: found.unsampled,
         }
+    }
+
+    /// Whether every light is a quad light, nothing else emits (no `emission`, no
+    /// environment) and every material is plain Lambertian
+    /// ([`Material::is_lambertian`]): a path tracer's vertices then all shade the same
+    /// way (see `integrator::path::lanes`).
+    #[inline]
+    pub fn lambertian_and_quad_lit(&self) -> bool {
+        self.lambertian_and_quad_lit
     }
 
     /// What a ray travelling along `dir` that hits nothing sees: the environment map, or

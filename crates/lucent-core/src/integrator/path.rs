@@ -27,10 +27,17 @@
 //! light-sampled: the path follows its lobe, and a light that segment finds adds in full
 //! in every mode (EXTENSIONS.md), even past the last scattering event. Russian
 //! roulette, when about to go on, ends the path with probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
+//!
+//! The camera samples of a batch are taken one path at a time, or eight at a time in
+//! vector lanes ([`lanes`]) for Lambertian scenes lit by quad lights (the course's
+//! `cornellNEE` and dragon): the same numbers either way.
+
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 
 use super::light_sampling::{every_light, one_light_mis};
 use super::{CameraHit, Integrator, PixelSampling, TraceCounts};
-use crate::hit::SurfacePoint;
+use crate::hit::{Hit, SurfacePoint};
 use crate::math::{Color, Vec3A};
 use crate::ray::Ray;
 use crate::sampler::Sampler;
@@ -278,6 +285,24 @@ impl Integrator for PathTracer {
             k += 1;
         }
         total
+    }
+
+    /// A batch of camera samples: eight paths at a time in vector lanes where the scene
+    /// and settings allow ([`lanes`]), else one at a time; the same colours either way.
+    fn radiances(
+        &self,
+        scene: &Scene,
+        rays: &[Ray],
+        hits: &[Option<Hit>],
+        samplers: &mut [Sampler],
+        counts: &mut TraceCounts,
+        out: &mut [Color],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if lanes::applies(self, scene) {
+            return lanes::radiances(self, scene, rays, hits, samplers, counts, out);
+        }
+        super::one_at_a_time(self, scene, rays, hits, samplers, counts, out);
     }
 
     fn pixel_sampling(&self) -> PixelSampling {

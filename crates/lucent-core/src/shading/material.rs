@@ -72,6 +72,17 @@ impl Default for Material {
 }
 
 impl Material {
+    /// Whether the material scatters as a plain Lambertian surface, the same everywhere:
+    /// `brdf phong` with `specular 0`, no texture or bump map, no glass, no emission.
+    pub fn is_lambertian(&self) -> bool {
+        self.brdf == BrdfModel::Phong
+            && self.specular == Color::ZERO
+            && self.transparent == Color::ZERO
+            && self.emission == Color::ZERO
+            && self.diffuse_map.is_none()
+            && self.bump_map.is_none()
+    }
+
     /// The BSDF at a point with unit shading normal `normal`, the true surface's normal
     /// `geometric` (on the side of `normal`) and (textured) diffuse colour `diffuse`. A
     /// `transparent` material is a smooth dielectric, whatever its `brdf`.

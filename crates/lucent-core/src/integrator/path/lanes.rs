@@ -1,0 +1,667 @@
+//! The path tracer's paths eight at a time, in the lanes of AVX2 vectors, for the scenes
+//! whose every surface scatters the same simple way: `nexteventestimation mis`,
+//! `importancesampling cosine` or `brdf`, no Russian roulette, quad lights only, and
+//! Lambertian materials (`brdf phong` with `specular 0`, no maps, no emission, no glass).
+//!
+//! Eight paths go together, bounce by bounce: each path's segment is traced and its hit
+//! turned into a surface point one lane at a time (the BVH and the shapes' own code);
+//! then the light sample, the BSDF's value and density, the MIS weight's inputs, the next
+//! direction and the rays' offset origins are computed for all eight at once; the shadow
+//! rays are traced one lane at a time again. Every number is the one
+//! [`PathTracer::radiance`] computes for that path: the same operations in the same
+//! order, lane by lane (IEEE arithmetic gives the same bits in a vector lane as in a
+//! scalar register; the sine and cosine come from the same library call), and each path
+//! draws from its own sampler in the same order. A test compares the two on scenes of
+//! every shape.
+
+use std::arch::x86_64::*;
+use std::f32::consts::{FRAC_1_PI, PI};
+
+use super::{Came, DirectionSampling, Nee, PathTracer};
+use crate::hit::Hit;
+use crate::integrator::TraceCounts;
+use crate::light::{Light, QuadLight};
+use crate::math::{Color, Vec3A};
+use crate::ray::{Ray, EPSILON};
+use crate::sampler::Sampler;
+use crate::sampling::mis::power_heuristic;
+use crate::sampling::ONE_BELOW;
+use crate::scene::Scene;
+
+/// Paths carried together.
+const W: usize = 8;
+
+/// Whether the scene and settings are ones the lanes render (see the module's docs) on
+/// this CPU.
+pub(super) fn applies(pt: &PathTracer, scene: &Scene) -> bool {
+    let settings = pt.nee == Nee::Mis
+        && matches!(pt.sampling, DirectionSampling::Cosine | DirectionSampling::Brdf)
+        && !pt.russian_roulette;
+    settings && scene.lambertian_and_quad_lit() && std::is_x86_feature_detected!("avx2")
+}
+
+/// Eight lanes of one number.
+#[derive(Clone, Copy, Default)]
+#[repr(C, align(32))]
+struct L([f32; W]);
+
+/// Eight lanes of a vector, one array per axis.
+#[derive(Clone, Copy, Default)]
+struct L3 {
+    x: L,
+    y: L,
+    z: L,
+}
+
+impl L3 {
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: Vec3A) {
+        self.x.0[i] = v.x;
+        self.y.0[i] = v.y;
+        self.z.0[i] = v.z;
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> Vec3A {
+        Vec3A::new(self.x.0[i], self.y.0[i], self.z.0[i])
+    }
+}
+
+/// Eight paths on their way, and what their current vertices hold.
+#[derive(Default)]
+struct Paths {
+    total: L3,
+    beta: L3,
+    /// The density of the BSDF sample that made each path's current segment.
+    came_pdf: [f32; W],
+    rays: [Option<Ray>; W],
+    // The vertex each live path is at (written for the lanes in `shading`).
+    point: L3,
+    error: L3,
+    ng: L3,
+    n: L3,
+    kd: L3,
+    // The light sample's numbers (the light's own, after the choice) and the light's data.
+    light_u: L,
+    light_v: L,
+    corner: L3,
+    ab: L3,
+    ac: L3,
+    light_normal: L3,
+    area: L,
+    radiance: L3,
+    // The next direction's numbers, then its local azimuth's sine and cosine.
+    bounce_u: L,
+    bounce_v: L,
+    sin_phi: L,
+    cos_phi: L,
+    // What the vector code gives back.
+    light: LightLanes,
+    bounce: BounceLanes,
+}
+
+/// The light sample of each lane, before its shadow ray.
+#[derive(Default)]
+struct LightLanes {
+    /// Whether the sample is one (the light faces the point, its density is finite).
+    valid: [bool; W],
+    /// Its density (both choices), and the BSDF strategy's for the same direction.
+    pdf: L,
+    bsdf_pdf: L,
+    /// `f · Le · cos / pdf`, zero where the light is below either normal.
+    unshadowed: L3,
+    origin: L3,
+    dir: L3,
+    t_max: L,
+}
+
+/// The next segment of each lane.
+#[derive(Default)]
+struct BounceLanes {
+    /// Whether the path goes on.
+    on: [bool; W],
+    pdf: L,
+    beta: L3,
+    origin: L3,
+    dir: L3,
+}
+
+/// [`PathTracer::radiances`] for a scene where [`applies`] holds.
+pub(super) fn radiances(
+    pt: &PathTracer,
+    scene: &Scene,
+    rays: &[Ray],
+    hits: &[Option<Hit>],
+    samplers: &mut [Sampler],
+    counts: &mut TraceCounts,
+    out: &mut [Color],
+) {
+    let quads: Vec<&QuadLight> = scene
+        .lights
+        .iter()
+        .map(|l| match l {
+            Light::Quad(q) => q,
+            _ => unreachable!("`applies` admits quad lights only"),
+        })
+        .collect();
+    let mut start = 0;
+    while start < rays.len() {
+        let end = (start + W).min(rays.len());
+        let mut paths = Paths::default();
+        let live = end - start;
+        for i in 0..live {
+            paths.rays[i] = Some(rays[start + i]);
+            paths.beta.set(i, Color::ONE);
+        }
+        run(
+            pt,
+            scene,
+            &quads,
+            &mut paths,
+            &hits[start..end],
+            &mut samplers[start..end],
+            counts,
+        );
+        for i in 0..live {
+            out[start + i] = paths.total.get(i);
+        }
+        start = end;
+    }
+}
+
+/// Takes up to eight paths (the first `hits.len()` lanes, their camera rays in
+/// `paths.rays`, already traced to `hits`) to their ends.
+fn run(
+    pt: &PathTracer,
+    scene: &Scene,
+    quads: &[&QuadLight],
+    paths: &mut Paths,
+    camera_hits: &[Option<Hit>],
+    samplers: &mut [Sampler],
+    counts: &mut TraceCounts,
+) {
+    let count = quads.len();
+    let mut k = 1u32;
+    loop {
+        // Trace, and turn each hit into a vertex to shade (or end the path).
+        let mut shading = [false; W];
+        let mut any = false;
+        for i in 0..samplers.len() {
+            let Some(ray) = paths.rays[i] else {
+                continue;
+            };
+            counts.rays += 1;
+            let hit = if k == 1 {
+                camera_hits[i]
+            } else {
+                scene.closest_hit(&ray)
+            };
+            paths.rays[i] = None;
+            // A segment that escapes finds nothing (no environment here).
+            let Some(hit) = hit else {
+                continue;
+            };
+            let came = if k == 1 {
+                Came::Camera
+            } else {
+                Came::Bsdf(paths.came_pdf[i])
+            };
+            let sp = scene.surface_point(&hit, &ray);
+            if let Some(index) = sp.light {
+                let light = &scene.lights[index as usize];
+                let le = light.radiance_seen(ray.dir, sp.normal);
+                if le != Color::ZERO {
+                    let p_light = || light.pdf_li(hit.t, ray.dir) / count as f32;
+                    let beta = paths.beta.get(i);
+                    let total = paths.total.get(i) + beta * le * pt.found_weight(came, true, p_light);
+                    paths.total.set(i, total);
+                }
+                continue;
+            }
+            if !pt.within_depth(k) {
+                continue;
+            }
+            let m = &scene.materials[sp.material as usize];
+            paths.point.set(i, sp.point);
+            paths.error.set(i, sp.error);
+            paths.ng.set(i, sp.geometric_normal);
+            paths.n.set(i, sp.normal);
+            paths.kd.set(i, m.diffuse);
+            // The light sample's numbers: the light chosen by the first, what is left of
+            // it the point's first coordinate (as `one_light_mis` does).
+            let sampler = &mut samplers[i];
+            let (u, v) = sampler.uniform2();
+            let scaled = u * count as f32;
+            let index = (scaled as usize).min(count - 1);
+            paths.light_u.0[i] = (scaled - index as f32).clamp(0.0, ONE_BELOW);
+            paths.light_v.0[i] = v;
+            let q = quads[index];
+            paths.corner.set(i, q.corner);
+            paths.ab.set(i, q.ab);
+            paths.ac.set(i, q.ac);
+            paths.light_normal.set(i, q.normal);
+            paths.area.0[i] = q.area;
+            paths.radiance.set(i, q.radiance);
+            // The next direction's numbers (`sample_reusing` of a single lobe clamps the
+            // first as the lobe's share of it).
+            let (u, v) = sampler.uniform2();
+            paths.bounce_u.0[i] = match pt.sampling {
+                DirectionSampling::Brdf => ((u - 0.0) / (1.0 - 0.0)).clamp(0.0, ONE_BELOW),
+                _ => u,
+            };
+            paths.bounce_v.0[i] = v;
+            shading[i] = true;
+            any = true;
+        }
+        if !any {
+            return;
+        }
+        // SAFETY: `applies` checked that the CPU has AVX2.
+        unsafe { light_samples(paths, count as f32) };
+        for i in (0..W).filter(|&i| shading[i]) {
+            let l = &paths.light;
+            let mut c = Color::ZERO;
+            if l.valid[i] {
+                let weight = power_heuristic(l.pdf.0[i], l.bsdf_pdf.0[i]);
+                let unshadowed = l.unshadowed.get(i);
+                if unshadowed != Color::ZERO {
+                    counts.rays += 1;
+                    let shadow = Ray::segment(l.origin.get(i), l.dir.get(i), EPSILON, l.t_max.0[i]);
+                    if !scene.occluded(&shadow) {
+                        c = unshadowed * weight;
+                    }
+                }
+            }
+            let total = paths.total.get(i) + paths.beta.get(i) * c;
+            paths.total.set(i, total);
+            let (s, cos) = (2.0 * PI * paths.bounce_v.0[i]).sin_cos();
+            paths.sin_phi.0[i] = s;
+            paths.cos_phi.0[i] = cos;
+        }
+        // SAFETY: as above.
+        unsafe { bounces(paths) };
+        for i in (0..W).filter(|&i| shading[i]) {
+            let b = &paths.bounce;
+            if b.on[i] {
+                paths.beta.set(i, b.beta.get(i));
+                paths.came_pdf[i] = b.pdf.0[i];
+                paths.rays[i] = Some(Ray::new(b.origin.get(i), b.dir.get(i)));
+            }
+        }
+        k += 1;
+    }
+}
+
+/// One lane group's numbers.
+type F = __m256;
+
+/// Three of them: a vector per lane.
+#[derive(Clone, Copy)]
+struct V {
+    x: F,
+    y: F,
+    z: F,
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn load(l: &L) -> F {
+    // SAFETY: `L` is 32-byte aligned and holds eight floats.
+    unsafe { _mm256_load_ps(l.0.as_ptr()) }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn store(l: &mut L, v: F) {
+    // SAFETY: as in `load`.
+    unsafe { _mm256_store_ps(l.0.as_mut_ptr(), v) }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn load3(l: &L3) -> V {
+    V {
+        x: load(&l.x),
+        y: load(&l.y),
+        z: load(&l.z),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn store3(l: &mut L3, v: V) {
+    store(&mut l.x, v.x);
+    store(&mut l.y, v.y);
+    store(&mut l.z, v.z);
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn mask(m: F) -> [bool; W] {
+    let bits = _mm256_movemask_ps(m);
+    std::array::from_fn(|i| bits & (1 << i) != 0)
+}
+
+// Vector operations with glam's order of operations (its SSE2 `Vec3A`): a dot product is
+// `(x·x' + y·y') + z·z'`, a normalisation a division by the square root of that.
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn add(a: V, b: V) -> V {
+    V {
+        x: _mm256_add_ps(a.x, b.x),
+        y: _mm256_add_ps(a.y, b.y),
+        z: _mm256_add_ps(a.z, b.z),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn sub(a: V, b: V) -> V {
+    V {
+        x: _mm256_sub_ps(a.x, b.x),
+        y: _mm256_sub_ps(a.y, b.y),
+        z: _mm256_sub_ps(a.z, b.z),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn mul(a: V, b: V) -> V {
+    V {
+        x: _mm256_mul_ps(a.x, b.x),
+        y: _mm256_mul_ps(a.y, b.y),
+        z: _mm256_mul_ps(a.z, b.z),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn scale(a: V, s: F) -> V {
+    V {
+        x: _mm256_mul_ps(a.x, s),
+        y: _mm256_mul_ps(a.y, s),
+        z: _mm256_mul_ps(a.z, s),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn divide(a: V, s: F) -> V {
+    V {
+        x: _mm256_div_ps(a.x, s),
+        y: _mm256_div_ps(a.y, s),
+        z: _mm256_div_ps(a.z, s),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn dot(a: V, b: V) -> F {
+    _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(a.x, b.x), _mm256_mul_ps(a.y, b.y)),
+        _mm256_mul_ps(a.z, b.z),
+    )
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn abs(a: V) -> V {
+    let m = _mm256_set1_ps(-0.0);
+    V {
+        x: _mm256_andnot_ps(m, a.x),
+        y: _mm256_andnot_ps(m, a.y),
+        z: _mm256_andnot_ps(m, a.z),
+    }
+}
+
+#[inline]
+#[target_feature(enable = "avx2")]
+fn select(m: F, a: V, b: V) -> V {
+    V {
+        x: _mm256_blendv_ps(b.x, a.x, m),
+        y: _mm256_blendv_ps(b.y, a.y, m),
+        z: _mm256_blendv_ps(b.z, a.z, m),
+    }
+}
+
+/// Lanes where `a > 0` (false for NaN).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn positive(a: F) -> F {
+    _mm256_cmp_ps::<_CMP_GT_OQ>(a, _mm256_setzero_ps())
+}
+
+/// `x.max(0.0)` as Rust computes it for `f32` (NaN gives 0).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn max0(a: F) -> F {
+    _mm256_max_ps(a, _mm256_setzero_ps())
+}
+
+/// [`crate::spawn::offset_origin`] in every lane.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn offset_origin(point: V, error: V, ng: V, dir: V) -> V {
+    let distance = dot(abs(ng), error);
+    let offset = scale(ng, distance);
+    let flip = _mm256_cmp_ps::<_CMP_LT_OQ>(dot(dir, ng), _mm256_setzero_ps());
+    let sign = _mm256_and_ps(flip, _mm256_set1_ps(-0.0));
+    let offset = V {
+        x: _mm256_xor_ps(offset.x, sign),
+        y: _mm256_xor_ps(offset.y, sign),
+        z: _mm256_xor_ps(offset.z, sign),
+    };
+    let m = add(point, offset);
+    V {
+        x: one_ulp_along(m.x, offset.x),
+        y: one_ulp_along(m.y, offset.y),
+        z: one_ulp_along(m.z, offset.z),
+    }
+}
+
+/// `m` one ulp further along the sign of `o`, lane by lane (`crate::spawn`'s
+/// `one_ulp_along`, eight lanes wide: the same bits).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn one_ulp_along(m: F, o: F) -> F {
+    let zero = _mm256_setzero_ps();
+    let int = _mm256_castps_si256;
+    let select = |mask: __m256i, a: __m256i, b: __m256i| _mm256_blendv_epi8(b, a, mask);
+    let (up, down) = (
+        int(_mm256_cmp_ps::<_CMP_GT_OQ>(o, zero)),
+        int(_mm256_cmp_ps::<_CMP_LT_OQ>(o, zero)),
+    );
+    let outward = _mm256_or_si256(
+        _mm256_and_si256(int(_mm256_cmp_ps::<_CMP_GT_OQ>(m, zero)), up),
+        _mm256_and_si256(int(_mm256_cmp_ps::<_CMP_LT_OQ>(m, zero)), down),
+    );
+    let stepped = _mm256_sub_epi32(int(m), _mm256_or_si256(outward, _mm256_set1_epi32(1)));
+    let smallest = _mm256_or_si256(
+        _mm256_set1_epi32(1),
+        _mm256_and_si256(down, _mm256_set1_epi32(i32::MIN)),
+    );
+    let from_zero = int(_mm256_cmp_ps::<_CMP_EQ_OQ>(m, zero));
+    let infinite = int(_mm256_cmp_ps::<_CMP_EQ_OQ>(
+        _mm256_andnot_ps(_mm256_set1_ps(-0.0), m),
+        _mm256_set1_ps(f32::INFINITY),
+    ));
+    let keep = _mm256_or_si256(
+        _mm256_andnot_si256(_mm256_or_si256(up, down), _mm256_set1_epi32(-1)),
+        _mm256_or_si256(
+            int(_mm256_cmp_ps::<_CMP_UNORD_Q>(m, m)),
+            _mm256_and_si256(infinite, outward),
+        ),
+    );
+    _mm256_castsi256_ps(select(keep, int(m), select(from_zero, smallest, stepped)))
+}
+
+/// The light samples of all lanes (`QuadLight::sample_li`, the density divided by the
+/// `count` lights, `unshadowed` of `light_sampling`, the shadow ray's origin and extent)
+/// and the prelude of the next direction (its polar cosine and sine).
+#[target_feature(enable = "avx2")]
+fn light_samples(p: &mut Paths, count: f32) {
+    let x = load3(&p.point);
+    let (u, v) = (load(&p.light_u), load(&p.light_v));
+    let y = add(add(load3(&p.corner), scale(load3(&p.ab), u)), scale(load3(&p.ac), v));
+    let to_light = sub(y, x);
+    let r2 = dot(to_light, to_light);
+    let distance = _mm256_sqrt_ps(r2);
+    let wi = divide(to_light, distance);
+    let cos_times_distance = dot(load3(&p.light_normal), to_light);
+    let pdf = _mm256_div_ps(
+        _mm256_mul_ps(r2, distance),
+        _mm256_mul_ps(load(&p.area), cos_times_distance),
+    );
+    let finite = _mm256_cmp_ps::<_CMP_LT_OQ>(
+        _mm256_andnot_ps(_mm256_set1_ps(-0.0), pdf),
+        _mm256_set1_ps(f32::INFINITY),
+    );
+    let valid = _mm256_and_ps(positive(cos_times_distance), finite);
+    let pdf = _mm256_div_ps(pdf, _mm256_set1_ps(count));
+    // The BSDF strategy's density of `wi`: cosine-weighted (`brdf` with one diffuse lobe
+    // is the same density, times 1).
+    let n = load3(&p.n);
+    let cos = dot(n, wi);
+    let bsdf_pdf = _mm256_mul_ps(max0(cos), _mm256_set1_ps(FRAC_1_PI));
+    let ng = load3(&p.ng);
+    let lit = _mm256_and_ps(positive(cos), positive(dot(wi, ng)));
+    let f = scale(load3(&p.kd), _mm256_set1_ps(FRAC_1_PI));
+    let c = scale(mul(f, load3(&p.radiance)), _mm256_div_ps(cos, pdf));
+    let zero = V {
+        x: _mm256_setzero_ps(),
+        y: _mm256_setzero_ps(),
+        z: _mm256_setzero_ps(),
+    };
+    let l = &mut p.light;
+    l.valid = mask(valid);
+    store(&mut l.pdf, pdf);
+    store(&mut l.bsdf_pdf, bsdf_pdf);
+    store3(&mut l.unshadowed, select(lit, c, zero));
+    store3(&mut l.origin, offset_origin(x, load3(&p.error), ng, wi));
+    store3(&mut l.dir, wi);
+    store(&mut l.t_max, _mm256_sub_ps(distance, _mm256_set1_ps(EPSILON)));
+}
+
+/// The next direction of all lanes (a cosine-weighted direction around the shading
+/// normal, from the numbers and the azimuth's sine and cosine in `p`), its value and
+/// density, the throughput after it, and the ray's origin.
+#[target_feature(enable = "avx2")]
+fn bounces(p: &mut Paths) {
+    let one = _mm256_set1_ps(1.0);
+    let cos_t = _mm256_sqrt_ps(load(&p.bounce_u));
+    let sin_t = _mm256_sqrt_ps(max0(_mm256_sub_ps(one, _mm256_mul_ps(cos_t, cos_t))));
+    let local = V {
+        x: _mm256_mul_ps(sin_t, load(&p.cos_phi)),
+        y: _mm256_mul_ps(sin_t, load(&p.sin_phi)),
+        z: cos_t,
+    };
+    // `Frame::around(n)`.
+    let n = load3(&p.n);
+    let sign = _mm256_or_ps(one, _mm256_and_ps(n.z, _mm256_set1_ps(-0.0)));
+    let a = _mm256_div_ps(_mm256_set1_ps(-1.0), _mm256_add_ps(sign, n.z));
+    let b = _mm256_mul_ps(_mm256_mul_ps(n.x, n.y), a);
+    let negate = |v: F| _mm256_xor_ps(v, _mm256_set1_ps(-0.0));
+    let t1 = V {
+        x: _mm256_add_ps(one, _mm256_mul_ps(_mm256_mul_ps(_mm256_mul_ps(sign, n.x), n.x), a)),
+        y: _mm256_mul_ps(sign, b),
+        z: _mm256_mul_ps(negate(sign), n.x),
+    };
+    let t2 = V {
+        x: b,
+        y: _mm256_add_ps(sign, _mm256_mul_ps(_mm256_mul_ps(n.y, n.y), a)),
+        z: negate(n.y),
+    };
+    let wi = add(add(scale(t1, local.x), scale(t2, local.y)), scale(n, local.z));
+    let cos = dot(n, wi);
+    let pdf = _mm256_mul_ps(max0(cos), _mm256_set1_ps(FRAC_1_PI));
+    let f = scale(load3(&p.kd), _mm256_set1_ps(FRAC_1_PI));
+    let ng = load3(&p.ng);
+    let valid = _mm256_and_ps(_mm256_and_ps(positive(cos), positive(pdf)), positive(dot(wi, ng)));
+    let beta = mul(load3(&p.beta), scale(f, _mm256_div_ps(cos, pdf)));
+    // `go_on` without Russian roulette: a finite throughput that is not black.
+    let finite =
+        |a: F| _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(_mm256_set1_ps(-0.0), a), _mm256_set1_ps(f32::INFINITY));
+    let nonzero = |a: F| _mm256_cmp_ps::<_CMP_NEQ_UQ>(a, _mm256_setzero_ps());
+    let on = _mm256_and_ps(
+        _mm256_and_ps(
+            valid,
+            _mm256_and_ps(finite(beta.x), _mm256_and_ps(finite(beta.y), finite(beta.z))),
+        ),
+        _mm256_or_ps(nonzero(beta.x), _mm256_or_ps(nonzero(beta.y), nonzero(beta.z))),
+    );
+    let b = &mut p.bounce;
+    b.on = mask(on);
+    store(&mut b.pdf, pdf);
+    store3(&mut b.beta, beta);
+    store3(&mut b.origin, offset_origin(load3(&p.point), load3(&p.error), ng, wi));
+    store3(&mut b.dir, wi);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spawn::{next_down, next_up};
+
+    #[target_feature(enable = "avx2")]
+    fn stepped(m: &L, o: &L) -> L {
+        let mut r = L::default();
+        store(&mut r, one_ulp_along(load(m), load(o)));
+        r
+    }
+
+    #[test]
+    fn a_lane_steps_one_ulp_as_next_up_and_next_down_do() {
+        if !std::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: no AVX2 on this CPU");
+            return;
+        }
+        let special = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            1e-30,
+            -3.5e7,
+        ];
+        let offsets = [0.0, -0.0, 1e-6, -1e-6, 1.0, -1.0, f32::NAN, f32::INFINITY];
+        let mut x = 0x2545_f491u32;
+        let mut random = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            f32::from_bits(x)
+        };
+        let values: Vec<f32> = special.iter().copied().chain((0..4000).map(|_| random())).collect();
+        for (i, chunk) in values.chunks(W).enumerate() {
+            let mut m = L::default();
+            let mut o = L::default();
+            for (k, &v) in chunk.iter().enumerate() {
+                m.0[k] = v;
+                o.0[k] = offsets[(i + k) % offsets.len()];
+            }
+            // SAFETY: the CPU has AVX2 (checked above).
+            let got = unsafe { stepped(&m, &o) };
+            for k in 0..W {
+                let (m, o) = (m.0[k], o.0[k]);
+                let want = if o > 0.0 {
+                    next_up(m)
+                } else if o < 0.0 {
+                    next_down(m)
+                } else {
+                    m
+                };
+                assert_eq!(got.0[k].to_bits(), want.to_bits(), "{m} along {o}");
+            }
+        }
+    }
+}
