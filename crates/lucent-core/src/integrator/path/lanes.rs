@@ -18,10 +18,11 @@ use std::arch::x86_64::*;
 use std::f32::consts::{FRAC_1_PI, PI};
 
 use super::{Came, DirectionSampling, Nee, PathTracer};
+use crate::geometry::primitive::Shape;
 use crate::hit::Hit;
 use crate::integrator::TraceCounts;
 use crate::light::{Light, QuadLight};
-use crate::math::{Color, Vec3A};
+use crate::math::{gamma, Color, Vec3A};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::Sampler;
 use crate::sampling::mis::power_heuristic;
@@ -75,6 +76,13 @@ struct Paths {
     /// The density of the BSDF sample that made each path's current segment.
     came_pdf: [f32; W],
     rays: [Option<Ray>; W],
+    // A flat triangle's corners and the hit's barycentric weights, for the lanes whose
+    // vertex is on one.
+    p0: L3,
+    p1: L3,
+    p2: L3,
+    b1: L,
+    b2: L,
     // The vertex each live path is at (written for the lanes in `shading`).
     point: L3,
     error: L3,
@@ -185,6 +193,7 @@ fn run(
     loop {
         // Trace, and turn each hit into a vertex to shade (or end the path).
         let mut shading = [false; W];
+        let mut flat = [false; W];
         let mut any = false;
         for i in 0..samplers.len() {
             let Some(ray) = paths.rays[i] else {
@@ -206,27 +215,43 @@ fn run(
             } else {
                 Came::Bsdf(paths.came_pdf[i])
             };
-            let sp = scene.surface_point(&hit, &ray);
-            if let Some(index) = sp.light {
-                let light = &scene.lights[index as usize];
-                let le = light.radiance_seen(ray.dir, sp.normal);
-                if le != Color::ZERO {
-                    let p_light = || light.pdf_li(hit.t, ray.dir) / count as f32;
-                    let beta = paths.beta.get(i);
-                    let total = paths.total.get(i) + beta * le * pt.found_weight(came, true, p_light);
-                    paths.total.set(i, total);
+            // A flat triangle's surface point is made in the lanes below; any other
+            // shape (and a light's surface) makes its own here.
+            let prim = &scene.geometry.primitives[hit.prim as usize];
+            let material = match (&prim.shape, prim.light) {
+                (Shape::Triangle { p, normals: None }, None) => {
+                    paths.p0.set(i, p[0]);
+                    paths.p1.set(i, p[1]);
+                    paths.p2.set(i, p[2]);
+                    paths.b1.0[i] = hit.b1;
+                    paths.b2.0[i] = hit.b2;
+                    flat[i] = true;
+                    prim.material
                 }
-                continue;
-            }
+                _ => {
+                    let sp = scene.surface_point(&hit, &ray);
+                    if let Some(index) = sp.light {
+                        let light = &scene.lights[index as usize];
+                        let le = light.radiance_seen(ray.dir, sp.normal);
+                        if le != Color::ZERO {
+                            let p_light = || light.pdf_li(hit.t, ray.dir) / count as f32;
+                            let beta = paths.beta.get(i);
+                            let total = paths.total.get(i) + beta * le * pt.found_weight(came, true, p_light);
+                            paths.total.set(i, total);
+                        }
+                        continue;
+                    }
+                    paths.point.set(i, sp.point);
+                    paths.error.set(i, sp.error);
+                    paths.ng.set(i, sp.geometric_normal);
+                    paths.n.set(i, sp.normal);
+                    sp.material
+                }
+            };
             if !pt.within_depth(k) {
                 continue;
             }
-            let m = &scene.materials[sp.material as usize];
-            paths.point.set(i, sp.point);
-            paths.error.set(i, sp.error);
-            paths.ng.set(i, sp.geometric_normal);
-            paths.n.set(i, sp.normal);
-            paths.kd.set(i, m.diffuse);
+            paths.kd.set(i, scene.materials[material as usize].diffuse);
             // The light sample's numbers: the light chosen by the first, what is left of
             // it the point's first coordinate (as `one_light_mis` does).
             let sampler = &mut samplers[i];
@@ -255,6 +280,10 @@ fn run(
         }
         if !any {
             return;
+        }
+        if flat.contains(&true) {
+            // SAFETY: `applies` checked that the CPU has AVX2.
+            unsafe { triangle_points(paths, flat) };
         }
         // SAFETY: `applies` checked that the CPU has AVX2.
         unsafe { light_samples(paths, count as f32) };
@@ -404,6 +433,24 @@ fn dot(a: V, b: V) -> F {
     )
 }
 
+/// glam's `cross`: `(a.y·b.z − a.z·b.y, a.z·b.x − a.x·b.z, a.x·b.y − a.y·b.x)`.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn cross(a: V, b: V) -> V {
+    V {
+        x: _mm256_sub_ps(_mm256_mul_ps(a.y, b.z), _mm256_mul_ps(a.z, b.y)),
+        y: _mm256_sub_ps(_mm256_mul_ps(a.z, b.x), _mm256_mul_ps(a.x, b.z)),
+        z: _mm256_sub_ps(_mm256_mul_ps(a.x, b.y), _mm256_mul_ps(a.y, b.x)),
+    }
+}
+
+/// glam's `normalize`: divided by the square root of the dot product with itself.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn normalize(a: V) -> V {
+    divide(a, _mm256_sqrt_ps(dot(a, a)))
+}
+
 #[inline]
 #[target_feature(enable = "avx2")]
 fn abs(a: V) -> V {
@@ -494,6 +541,38 @@ fn one_ulp_along(m: F, o: F) -> F {
         ),
     );
     _mm256_castsi256_ps(select(keep, int(m), select(from_zero, smallest, stepped)))
+}
+
+/// The surface points of the lanes in `flat`, on flat triangles
+/// (`spawn::barycentric_point` and `triangle::geometric_normal`, the shading normal the
+/// same); the other lanes keep theirs.
+#[target_feature(enable = "avx2")]
+fn triangle_points(p: &mut Paths, flat: [bool; W]) {
+    let keep = _mm256_castsi256_ps(_mm256_setr_epi32(
+        -(flat[0] as i32),
+        -(flat[1] as i32),
+        -(flat[2] as i32),
+        -(flat[3] as i32),
+        -(flat[4] as i32),
+        -(flat[5] as i32),
+        -(flat[6] as i32),
+        -(flat[7] as i32),
+    ));
+    let (p0, p1, p2) = (load3(&p.p0), load3(&p.p1), load3(&p.p2));
+    let (b1, b2) = (load(&p.b1), load(&p.b2));
+    let b0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0), b1), b2);
+    let (a, b, c) = (scale(p0, b0), scale(p1, b1), scale(p2, b2));
+    let point = add(add(a, b), c);
+    let error = scale(add(add(abs(a), abs(b)), abs(c)), _mm256_set1_ps(gamma(8)));
+    let ng = normalize(cross(sub(p1, p0), sub(p2, p0)));
+    let put = |l: &mut L3, v: V| {
+        let old = load3(l);
+        store3(l, select(keep, v, old));
+    };
+    put(&mut p.point, point);
+    put(&mut p.error, error);
+    put(&mut p.ng, ng);
+    put(&mut p.n, ng);
 }
 
 /// The light samples of all lanes (`QuadLight::sample_li`, the density divided by the
