@@ -25,7 +25,6 @@ use crate::light::{Light, QuadLight};
 use crate::math::{gamma, Color, Vec3A};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::Sampler;
-use crate::sampling::mis::power_heuristic;
 use crate::sampling::ONE_BELOW;
 use crate::scene::Scene;
 
@@ -103,6 +102,9 @@ struct Paths {
     bounce_v: L,
     sin_phi: L,
     cos_phi: L,
+    /// The lanes with a vertex to shade, and those whose light sample nothing blocks.
+    shading: [bool; W],
+    lit: [bool; W],
     // What the vector code gives back.
     light: LightLanes,
     bounce: BounceLanes,
@@ -118,6 +120,8 @@ struct LightLanes {
     bsdf_pdf: L,
     /// `f · Le · cos / pdf`, zero where the light is below either normal.
     unshadowed: L3,
+    /// That times the MIS weight: what the sample adds if nothing blocks it.
+    weighted: L3,
     origin: L3,
     dir: L3,
     t_max: L,
@@ -289,24 +293,18 @@ fn run(
         unsafe { light_samples(paths, count as f32) };
         for i in (0..W).filter(|&i| shading[i]) {
             let l = &paths.light;
-            let mut c = Color::ZERO;
-            if l.valid[i] {
-                let weight = power_heuristic(l.pdf.0[i], l.bsdf_pdf.0[i]);
-                let unshadowed = l.unshadowed.get(i);
-                if unshadowed != Color::ZERO {
-                    counts.rays += 1;
-                    let shadow = Ray::segment(l.origin.get(i), l.dir.get(i), EPSILON, l.t_max.0[i]);
-                    if !scene.occluded(&shadow) {
-                        c = unshadowed * weight;
-                    }
-                }
+            if l.valid[i] && l.unshadowed.get(i) != Color::ZERO {
+                counts.rays += 1;
+                let shadow = Ray::segment(l.origin.get(i), l.dir.get(i), EPSILON, l.t_max.0[i]);
+                paths.lit[i] = !scene.occluded(&shadow);
+            } else {
+                paths.lit[i] = false;
             }
-            let total = paths.total.get(i) + paths.beta.get(i) * c;
-            paths.total.set(i, total);
             let (s, cos) = (2.0 * PI * paths.bounce_v.0[i]).sin_cos();
             paths.sin_phi.0[i] = s;
             paths.cos_phi.0[i] = cos;
         }
+        paths.shading = shading;
         // SAFETY: as above.
         unsafe { bounces(paths) };
         for i in (0..W).filter(|&i| shading[i]) {
@@ -472,6 +470,43 @@ fn select(m: F, a: V, b: V) -> V {
     }
 }
 
+/// A mask of the lanes set in `b`.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn lane_mask(b: [bool; W]) -> F {
+    _mm256_castsi256_ps(_mm256_setr_epi32(
+        -(b[0] as i32),
+        -(b[1] as i32),
+        -(b[2] as i32),
+        -(b[3] as i32),
+        -(b[4] as i32),
+        -(b[5] as i32),
+        -(b[6] as i32),
+        -(b[7] as i32),
+    ))
+}
+
+/// `sampling::mis::power_heuristic` in every lane (in `f64`, as it is computed there).
+#[inline]
+#[target_feature(enable = "avx2")]
+fn power_heuristic_lanes(pa: F, pb: F) -> F {
+    // Four lanes at a time, widened to `f64`.
+    let half = |pa: __m128, pb: __m128| -> __m128 {
+        let (pa, pb) = (_mm256_cvtps_pd(pa), _mm256_cvtps_pd(pb));
+        let (a, b) = (_mm256_mul_pd(pa, pa), _mm256_mul_pd(pb, pb));
+        let sum = _mm256_add_pd(a, b);
+        let positive = _mm256_cmp_pd::<_CMP_GT_OQ>(sum, _mm256_setzero_pd());
+        _mm256_cvtpd_ps(_mm256_and_pd(_mm256_div_pd(a, sum), positive))
+    };
+    let low = half(_mm256_castps256_ps128(pa), _mm256_castps256_ps128(pb));
+    let high = half(_mm256_extractf128_ps::<1>(pa), _mm256_extractf128_ps::<1>(pb));
+    let infinite = _mm256_cmp_ps::<_CMP_EQ_OQ>(
+        _mm256_andnot_ps(_mm256_set1_ps(-0.0), pa),
+        _mm256_set1_ps(f32::INFINITY),
+    );
+    _mm256_blendv_ps(_mm256_set_m128(high, low), _mm256_set1_ps(1.0), infinite)
+}
+
 /// Lanes where `a > 0` (false for NaN).
 #[inline]
 #[target_feature(enable = "avx2")]
@@ -548,16 +583,7 @@ fn one_ulp_along(m: F, o: F) -> F {
 /// same); the other lanes keep theirs.
 #[target_feature(enable = "avx2")]
 fn triangle_points(p: &mut Paths, flat: [bool; W]) {
-    let keep = _mm256_castsi256_ps(_mm256_setr_epi32(
-        -(flat[0] as i32),
-        -(flat[1] as i32),
-        -(flat[2] as i32),
-        -(flat[3] as i32),
-        -(flat[4] as i32),
-        -(flat[5] as i32),
-        -(flat[6] as i32),
-        -(flat[7] as i32),
-    ));
+    let keep = lane_mask(flat);
     let (p0, p1, p2) = (load3(&p.p0), load3(&p.p1), load3(&p.p2));
     let (b1, b2) = (load(&p.b1), load(&p.b2));
     let b0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0), b1), b2);
@@ -616,7 +642,9 @@ fn light_samples(p: &mut Paths, count: f32) {
     l.valid = mask(valid);
     store(&mut l.pdf, pdf);
     store(&mut l.bsdf_pdf, bsdf_pdf);
-    store3(&mut l.unshadowed, select(lit, c, zero));
+    let unshadowed = select(lit, c, zero);
+    store3(&mut l.unshadowed, unshadowed);
+    store3(&mut l.weighted, scale(unshadowed, power_heuristic_lanes(pdf, bsdf_pdf)));
     store3(&mut l.origin, offset_origin(x, load3(&p.error), ng, wi));
     store3(&mut l.dir, wi);
     store(&mut l.t_max, _mm256_sub_ps(distance, _mm256_set1_ps(EPSILON)));
@@ -627,6 +655,17 @@ fn light_samples(p: &mut Paths, count: f32) {
 /// density, the throughput after it, and the ray's origin.
 #[target_feature(enable = "avx2")]
 fn bounces(p: &mut Paths) {
+    // The light sample's share, added with the throughput before this bounce (as
+    // `one_light_mis`'s result is: nothing where the shadow ray was blocked).
+    let zero = V {
+        x: _mm256_setzero_ps(),
+        y: _mm256_setzero_ps(),
+        z: _mm256_setzero_ps(),
+    };
+    let c = select(lane_mask(p.lit), load3(&p.light.weighted), zero);
+    let total = load3(&p.total);
+    let with_light = add(total, mul(load3(&p.beta), c));
+    store3(&mut p.total, select(lane_mask(p.shading), with_light, total));
     let one = _mm256_set1_ps(1.0);
     let cos_t = _mm256_sqrt_ps(load(&p.bounce_u));
     let sin_t = _mm256_sqrt_ps(max0(_mm256_sub_ps(one, _mm256_mul_ps(cos_t, cos_t))));
