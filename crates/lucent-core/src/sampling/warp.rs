@@ -10,8 +10,36 @@ use crate::math::Vec3A;
 #[inline]
 fn spherical(cos_t: f32, v: f32) -> Vec3A {
     let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-    let (s, c) = (2.0 * PI * v).sin_cos();
+    let (s, c) = sin_cos_turns(v);
     Vec3A::new(sin_t * c, sin_t * s, cos_t)
+}
+
+/// Taylor coefficients of `sin 2πr` in odd powers of `r` (from r¹) and of `cos 2πr` in
+/// even powers (from r²): on |r| ≤ 1/8 the first left out is below 2·10⁻⁹, under a
+/// thirtieth of an `f32` ulp of the results there.
+pub const SIN_TURN: [f32; 5] = [6.283_185_3, -41.341_702, 81.605_25, -76.705_86, 42.058_694];
+pub const COS_TURN: [f32; 5] = [-19.739_208, 64.939_394, -85.456_82, 60.244_64, -26.426_257];
+
+/// `(sin 2πv, cos 2πv)` for `v` in [0, 1], about as accurate as the C library's `sincosf`
+/// (a few ulps) and without its call: the nearest quarter turn `q` is taken off exactly
+/// (`r = v − q/4`, |r| ≤ 1/8), the polynomials give the sine and cosine of `2πr`, and the
+/// quarter turns exchange and negate them. Plain multiplies and adds in a fixed order, so
+/// that the path tracer's vector lanes (`integrator::path::lanes`) give the same bits.
+#[inline]
+pub fn sin_cos_turns(v: f32) -> (f32, f32) {
+    let q = (4.0 * v + 0.5).floor();
+    let r = v - q * 0.25;
+    let z = r * r;
+    let [s1, s3, s5, s7, s9] = SIN_TURN;
+    let [c2, c4, c6, c8, c10] = COS_TURN;
+    let s = r * (s1 + z * (s3 + z * (s5 + z * (s7 + z * s9))));
+    let c = 1.0 + z * (c2 + z * (c4 + z * (c6 + z * (c8 + z * c10))));
+    match q as i32 & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
 }
 
 /// Uniform on the hemisphere z ≥ 0 (`importancesampling hemisphere`): cos θ = u.
@@ -92,6 +120,24 @@ pub fn ggx_half_vector_pdf(alpha: f32, cos_t: f32) -> f32 {
 mod tests {
     use super::super::chi2::chi2_test;
     use super::*;
+
+    #[test]
+    fn the_turns_sine_and_cosine_are_within_two_ulps_of_the_true_ones() {
+        // Every 2⁻²⁰ of a turn and the quarter turns' neighbours: against f64, at most
+        // 1.2·10⁻⁷ off (two ulps of numbers near 1; the C library's `sincosf` of the
+        // rounded 2πv is off by up to 4·10⁻⁷ near a whole turn).
+        let mut worst = 0.0f64;
+        let quarter_edges = [0.125f32, 0.375, 0.625, 0.875, 0.25, 0.5, 0.75, 1.0];
+        let edges = quarter_edges
+            .iter()
+            .flat_map(|&e| [crate::spawn::next_down(e), e, crate::spawn::next_up(e)]);
+        for v in (0..=1u32 << 20).map(|i| i as f32 / (1u32 << 20) as f32).chain(edges) {
+            let (s, c) = sin_cos_turns(v);
+            let t = std::f64::consts::TAU * v as f64;
+            worst = worst.max((s as f64 - t.sin()).abs()).max((c as f64 - t.cos()).abs());
+        }
+        assert!(worst < 1.2e-7, "{worst}");
+    }
 
     #[test]
     fn hemisphere_and_cosine_follow_their_densities() {

@@ -10,12 +10,12 @@
 //! rays are traced one lane at a time again. Every number is the one
 //! [`PathTracer::radiance`] computes for that path: the same operations in the same
 //! order, lane by lane (IEEE arithmetic gives the same bits in a vector lane as in a
-//! scalar register; the sine and cosine come from the same library call), and each path
-//! draws from its own sampler in the same order. A test compares the two on scenes of
+//! scalar register; the azimuth's sine and cosine are the same polynomial,
+//! `warp::sin_cos_turns`), and each path draws from its own sampler in the same order. A test compares the two on scenes of
 //! every shape.
 
 use std::arch::x86_64::*;
-use std::f32::consts::{FRAC_1_PI, PI};
+use std::f32::consts::FRAC_1_PI;
 
 use super::{Came, DirectionSampling, Nee, PathTracer};
 use crate::geometry::primitive::Shape;
@@ -25,6 +25,7 @@ use crate::light::{Light, QuadLight};
 use crate::math::{gamma, Color, Vec3A};
 use crate::ray::{Ray, EPSILON};
 use crate::sampler::Sampler;
+use crate::sampling::warp::{COS_TURN, SIN_TURN};
 use crate::sampling::ONE_BELOW;
 use crate::scene::Scene;
 
@@ -97,11 +98,9 @@ struct Paths {
     light_normal: L3,
     area: L,
     radiance: L3,
-    // The next direction's numbers, then its local azimuth's sine and cosine.
+    // The next direction's numbers.
     bounce_u: L,
     bounce_v: L,
-    sin_phi: L,
-    cos_phi: L,
     /// The lanes with a vertex to shade, and those whose light sample nothing blocks.
     shading: [bool; W],
     lit: [bool; W],
@@ -300,9 +299,6 @@ fn run(
             } else {
                 paths.lit[i] = false;
             }
-            let (s, cos) = (2.0 * PI * paths.bounce_v.0[i]).sin_cos();
-            paths.sin_phi.0[i] = s;
-            paths.cos_phi.0[i] = cos;
         }
         paths.shading = shading;
         // SAFETY: as above.
@@ -468,6 +464,39 @@ fn select(m: F, a: V, b: V) -> V {
         y: _mm256_blendv_ps(b.y, a.y, m),
         z: _mm256_blendv_ps(b.z, a.z, m),
     }
+}
+
+/// `warp::sin_cos_turns` in every lane: `(sin 2πv, cos 2πv)`, the same operations.
+#[inline]
+#[target_feature(enable = "avx2")]
+fn sin_cos_turns(v: F) -> (F, F) {
+    let splat = _mm256_set1_ps;
+    let q = _mm256_floor_ps(_mm256_add_ps(_mm256_mul_ps(splat(4.0), v), splat(0.5)));
+    let r = _mm256_sub_ps(v, _mm256_mul_ps(q, splat(0.25)));
+    let z = _mm256_mul_ps(r, r);
+    let horner = |k: [f32; 5]| {
+        let mut p = splat(k[4]);
+        for &c in k[..4].iter().rev() {
+            p = _mm256_add_ps(splat(c), _mm256_mul_ps(z, p));
+        }
+        p
+    };
+    let s = _mm256_mul_ps(r, horner(SIN_TURN));
+    let c = _mm256_add_ps(splat(1.0), _mm256_mul_ps(z, horner(COS_TURN)));
+    // Quarter turns: odd ones exchange the two, and the sine is negated in the second
+    // half turn (bit 1 of q), the cosine in the second and third quarters (bit 1 of q + 1).
+    let q = _mm256_cvttps_epi32(q);
+    let sign = _mm256_set1_epi32(i32::MIN);
+    let odd = _mm256_castsi256_ps(_mm256_slli_epi32::<31>(q));
+    let negate_sin = _mm256_castsi256_ps(_mm256_and_si256(_mm256_slli_epi32::<30>(q), sign));
+    let negate_cos = _mm256_castsi256_ps(_mm256_and_si256(
+        _mm256_slli_epi32::<30>(_mm256_add_epi32(q, _mm256_set1_epi32(1))),
+        sign,
+    ));
+    (
+        _mm256_xor_ps(_mm256_blendv_ps(s, c, odd), negate_sin),
+        _mm256_xor_ps(_mm256_blendv_ps(c, s, odd), negate_cos),
+    )
 }
 
 /// A mask of the lanes set in `b`.
@@ -669,9 +698,10 @@ fn bounces(p: &mut Paths) {
     let one = _mm256_set1_ps(1.0);
     let cos_t = _mm256_sqrt_ps(load(&p.bounce_u));
     let sin_t = _mm256_sqrt_ps(max0(_mm256_sub_ps(one, _mm256_mul_ps(cos_t, cos_t))));
+    let (sin_phi, cos_phi) = sin_cos_turns(load(&p.bounce_v));
     let local = V {
-        x: _mm256_mul_ps(sin_t, load(&p.cos_phi)),
-        y: _mm256_mul_ps(sin_t, load(&p.sin_phi)),
+        x: _mm256_mul_ps(sin_t, cos_phi),
+        y: _mm256_mul_ps(sin_t, sin_phi),
         z: cos_t,
     };
     // `Frame::around(n)`.
@@ -726,6 +756,42 @@ mod tests {
         let mut r = L::default();
         store(&mut r, one_ulp_along(load(m), load(o)));
         r
+    }
+
+    #[target_feature(enable = "avx2")]
+    fn turns(v: &L) -> (L, L) {
+        let (s, c) = sin_cos_turns(load(v));
+        let (mut a, mut b) = (L::default(), L::default());
+        store(&mut a, s);
+        store(&mut b, c);
+        (a, b)
+    }
+
+    #[test]
+    fn a_lanes_sine_and_cosine_are_the_scalar_ones_bit_for_bit() {
+        if !std::is_x86_feature_detected!("avx2") {
+            eprintln!("skipped: no AVX2 on this CPU");
+            return;
+        }
+        let n = 1u32 << 18;
+        let values = (0..=n)
+            .map(|i| i as f32 / n as f32)
+            .chain([crate::spawn::next_down(1.0), f32::from_bits(1)]);
+        let values: Vec<f32> = values.collect();
+        for chunk in values.chunks(W) {
+            let mut v = L::default();
+            v.0[..chunk.len()].copy_from_slice(chunk);
+            // SAFETY: the CPU has AVX2 (checked above).
+            let (s, c) = unsafe { turns(&v) };
+            for (k, &x) in chunk.iter().enumerate() {
+                let (ws, wc) = crate::sampling::warp::sin_cos_turns(x);
+                assert_eq!(
+                    (s.0[k].to_bits(), c.0[k].to_bits()),
+                    (ws.to_bits(), wc.to_bits()),
+                    "v = {x}"
+                );
+            }
+        }
     }
 
     #[test]
