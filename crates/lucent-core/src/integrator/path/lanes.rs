@@ -155,56 +155,67 @@ pub(super) fn radiances(
             _ => unreachable!("`applies` admits quad lights only"),
         })
         .collect();
-    let mut start = 0;
-    while start < rays.len() {
-        let end = (start + W).min(rays.len());
-        let mut paths = Paths::default();
-        let live = end - start;
-        for i in 0..live {
-            paths.rays[i] = Some(rays[start + i]);
-            paths.beta.set(i, Color::ONE);
-        }
-        run(
-            pt,
-            scene,
-            &quads,
-            &mut paths,
-            &hits[start..end],
-            &mut samplers[start..end],
-            counts,
-        );
-        for i in 0..live {
-            out[start + i] = paths.total.get(i);
-        }
-        start = end;
-    }
+    run(pt, scene, &quads, rays, hits, samplers, counts, out);
 }
 
-/// Takes up to eight paths (the first `hits.len()` lanes, their camera rays in
-/// `paths.rays`, already traced to `hits`) to their ends.
+/// No camera sample: a lane that carries no path.
+const FREE: usize = usize::MAX;
+
+/// Takes the batch's paths to their ends, eight at a time: a lane whose path ends takes
+/// the batch's next camera sample (its camera ray traced already, to `camera_hits`), so
+/// that the lanes stay full until the batch runs out. Each path's numbers are its own
+/// whatever lane carries it and whoever its neighbours are.
+#[allow(clippy::too_many_arguments)]
 fn run(
     pt: &PathTracer,
     scene: &Scene,
     quads: &[&QuadLight],
-    paths: &mut Paths,
+    camera_rays: &[Ray],
     camera_hits: &[Option<Hit>],
     samplers: &mut [Sampler],
     counts: &mut TraceCounts,
+    out: &mut [Color],
 ) {
     let count = quads.len();
-    let mut k = 1u32;
+    let mut paths = Paths::default();
+    // The camera sample each lane carries, and the index of the vertex its current
+    // segment will hit.
+    let mut sample = [FREE; W];
+    let mut k = [0u32; W];
+    let mut next = 0;
     loop {
+        // Lanes whose paths ended hand their light in and take the next sample.
+        for i in 0..W {
+            if paths.rays[i].is_some() {
+                continue;
+            }
+            if sample[i] != FREE {
+                out[sample[i]] = paths.total.get(i);
+                sample[i] = FREE;
+            }
+            if next < camera_rays.len() {
+                sample[i] = next;
+                k[i] = 1;
+                paths.rays[i] = Some(camera_rays[next]);
+                paths.total.set(i, Color::ZERO);
+                paths.beta.set(i, Color::ONE);
+                next += 1;
+            }
+        }
         // Trace, and turn each hit into a vertex to shade (or end the path).
         let mut shading = [false; W];
         let mut flat = [false; W];
         let mut any = false;
-        for i in 0..samplers.len() {
+        let mut live = false;
+        for i in 0..W {
             let Some(ray) = paths.rays[i] else {
                 continue;
             };
+            live = true;
+            let first = k[i] == 1;
             counts.rays += 1;
-            let hit = if k == 1 {
-                camera_hits[i]
+            let hit = if first {
+                camera_hits[sample[i]]
             } else {
                 scene.closest_hit(&ray)
             };
@@ -213,7 +224,7 @@ fn run(
             let Some(hit) = hit else {
                 continue;
             };
-            let came = if k == 1 {
+            let came = if first {
                 Came::Camera
             } else {
                 Came::Bsdf(paths.came_pdf[i])
@@ -251,13 +262,13 @@ fn run(
                     sp.material
                 }
             };
-            if !pt.within_depth(k) {
+            if !pt.within_depth(k[i]) {
                 continue;
             }
             paths.kd.set(i, scene.materials[material as usize].diffuse);
             // The light sample's numbers: the light chosen by the first, what is left of
             // it the point's first coordinate (as `one_light_mis` does).
-            let sampler = &mut samplers[i];
+            let sampler = &mut samplers[sample[i]];
             let (u, v) = sampler.uniform2();
             let scaled = u * count as f32;
             let index = (scaled as usize).min(count - 1);
@@ -281,15 +292,18 @@ fn run(
             shading[i] = true;
             any = true;
         }
-        if !any {
+        if !live {
             return;
+        }
+        if !any {
+            continue;
         }
         if flat.contains(&true) {
             // SAFETY: `applies` checked that the CPU has AVX2.
-            unsafe { triangle_points(paths, flat) };
+            unsafe { triangle_points(&mut paths, flat) };
         }
         // SAFETY: `applies` checked that the CPU has AVX2.
-        unsafe { light_samples(paths, count as f32) };
+        unsafe { light_samples(&mut paths, count as f32) };
         for i in (0..W).filter(|&i| shading[i]) {
             let l = &paths.light;
             if l.valid[i] && l.unshadowed.get(i) != Color::ZERO {
@@ -302,16 +316,16 @@ fn run(
         }
         paths.shading = shading;
         // SAFETY: as above.
-        unsafe { bounces(paths) };
+        unsafe { bounces(&mut paths) };
         for i in (0..W).filter(|&i| shading[i]) {
             let b = &paths.bounce;
             if b.on[i] {
                 paths.beta.set(i, b.beta.get(i));
                 paths.came_pdf[i] = b.pdf.0[i];
                 paths.rays[i] = Some(Ray::new(b.origin.get(i), b.dir.get(i)));
+                k[i] += 1;
             }
         }
-        k += 1;
     }
 }
 
