@@ -83,6 +83,8 @@ struct Paths {
     p2: L3,
     b1: L,
     b2: L,
+    /// The surface points made one lane at a time (shapes other than flat triangles).
+    other_shape: ShapePoints,
     // The vertex each live path is at (written for the lanes in `shading`).
     point: L3,
     error: L3,
@@ -107,6 +109,16 @@ struct Paths {
     // What the vector code gives back.
     light: LightLanes,
     bounce: BounceLanes,
+}
+
+/// Surface points in lanes: the point, its error bound, the geometric and the shading
+/// normals.
+#[derive(Default)]
+struct ShapePoints {
+    point: L3,
+    error: L3,
+    ng: L3,
+    n: L3,
 }
 
 /// The light sample of each lane, before its shadow ray.
@@ -255,10 +267,11 @@ fn run(
                         }
                         continue;
                     }
-                    paths.point.set(i, sp.point);
-                    paths.error.set(i, sp.error);
-                    paths.ng.set(i, sp.geometric_normal);
-                    paths.n.set(i, sp.normal);
+                    let other = &mut paths.other_shape;
+                    other.point.set(i, sp.point);
+                    other.error.set(i, sp.error);
+                    other.ng.set(i, sp.geometric_normal);
+                    other.n.set(i, sp.normal);
                     sp.material
                 }
             };
@@ -298,10 +311,8 @@ fn run(
         if !any {
             continue;
         }
-        if flat.contains(&true) {
-            // SAFETY: `applies` checked that the CPU has AVX2.
-            unsafe { triangle_points(&mut paths, flat) };
-        }
+        // SAFETY: `applies` checked that the CPU has AVX2.
+        unsafe { surface_points(&mut paths, flat) };
         // SAFETY: `applies` checked that the CPU has AVX2.
         unsafe { light_samples(&mut paths, count as f32) };
         for i in (0..W).filter(|&i| shading[i]) {
@@ -621,12 +632,12 @@ fn one_ulp_along(m: F, o: F) -> F {
     _mm256_castsi256_ps(select(keep, int(m), select(from_zero, smallest, stepped)))
 }
 
-/// The surface points of the lanes in `flat`, on flat triangles
-/// (`spawn::barycentric_point` and `triangle::geometric_normal`, the shading normal the
-/// same); the other lanes keep theirs.
+/// The surface points of all lanes: made here for the lanes in `flat`, on flat
+/// triangles (`spawn::barycentric_point` and `triangle::geometric_normal`, the shading
+/// normal the same), taken from `other_shape` for the others.
 #[target_feature(enable = "avx2")]
-fn triangle_points(p: &mut Paths, flat: [bool; W]) {
-    let keep = lane_mask(flat);
+fn surface_points(p: &mut Paths, flat: [bool; W]) {
+    let flat = lane_mask(flat);
     let (p0, p1, p2) = (load3(&p.p0), load3(&p.p1), load3(&p.p2));
     let (b1, b2) = (load(&p.b1), load(&p.b2));
     let b0 = _mm256_sub_ps(_mm256_sub_ps(_mm256_set1_ps(1.0), b1), b2);
@@ -634,14 +645,19 @@ fn triangle_points(p: &mut Paths, flat: [bool; W]) {
     let point = add(add(a, b), c);
     let error = scale(add(add(abs(a), abs(b)), abs(c)), _mm256_set1_ps(gamma(8)));
     let ng = normalize(cross(sub(p1, p0), sub(p2, p0)));
-    let put = |l: &mut L3, v: V| {
-        let old = load3(l);
-        store3(l, select(keep, v, old));
-    };
-    put(&mut p.point, point);
-    put(&mut p.error, error);
-    put(&mut p.ng, ng);
-    put(&mut p.n, ng);
+    // Whole stores of blends from two sources (a store of a blend with the old contents
+    // becomes a masked store, which Zen 4 runs in microcode: a tenth of the render).
+    let o = &p.other_shape;
+    let (point, error, ng, n) = (
+        select(flat, point, load3(&o.point)),
+        select(flat, error, load3(&o.error)),
+        select(flat, ng, load3(&o.ng)),
+        select(flat, ng, load3(&o.n)),
+    );
+    store3(&mut p.point, point);
+    store3(&mut p.error, error);
+    store3(&mut p.ng, ng);
+    store3(&mut p.n, n);
 }
 
 /// The light samples of all lanes (`QuadLight::sample_li`, the density divided by the
@@ -705,10 +721,12 @@ fn bounces(p: &mut Paths) {
         y: _mm256_setzero_ps(),
         z: _mm256_setzero_ps(),
     };
-    let c = select(lane_mask(p.lit), load3(&p.light.weighted), zero);
-    let total = load3(&p.total);
-    let with_light = add(total, mul(load3(&p.beta), c));
-    store3(&mut p.total, select(lane_mask(p.shading), with_light, total));
+    // Lanes not shading add nothing: `0 · β` to a total that is never −0 (a sum of
+    // products of non-negative numbers), with a finite β (`go_on` keeps only those).
+    let lit = _mm256_and_ps(lane_mask(p.lit), lane_mask(p.shading));
+    let c = select(lit, load3(&p.light.weighted), zero);
+    let total = add(load3(&p.total), mul(load3(&p.beta), c));
+    store3(&mut p.total, total);
     let one = _mm256_set1_ps(1.0);
     let cos_t = _mm256_sqrt_ps(load(&p.bounce_u));
     let sin_t = _mm256_sqrt_ps(max0(_mm256_sub_ps(one, _mm256_mul_ps(cos_t, cos_t))));
