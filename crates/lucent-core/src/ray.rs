@@ -43,7 +43,7 @@ impl Ray {
 
 /// `[kx, ky]` for the dominant axis `kz` (index `2·kz`), and exchanged for a direction
 /// that points down `kz` (index `2·kz + 1`): the next two axes in cyclic order.
-const AXES_AROUND: [[usize; 2]; 6] = [[1, 2], [2, 1], [2, 0], [0, 2], [0, 1], [1, 0]];
+pub(crate) const AXES_AROUND: [[usize; 2]; 6] = [[1, 2], [2, 1], [2, 0], [0, 2], [0, 1], [1, 0]];
 
 /// A ray with what every box and triangle test needs, computed once per ray: the
 /// reciprocal direction for slab tests and the shear of the watertight triangle test
@@ -68,6 +68,13 @@ pub struct PreparedRay {
     pub sx: f32,
     pub sy: f32,
     pub sz: f32,
+}
+
+impl Default for PreparedRay {
+    /// A ray from the origin along +z: a placeholder in arrays filled later.
+    fn default() -> PreparedRay {
+        PreparedRay::new(Ray::new(Vec3A::ZERO, Vec3A::Z))
+    }
 }
 
 impl PreparedRay {

@@ -11,7 +11,7 @@ use crate::light::emitters::{EmissiveSurfaces, Emitters};
 use crate::light::environment::EnvironmentLight;
 use crate::light::{Light, SampledLight};
 use crate::math::{Color, Vec3A};
-use crate::ray::Ray;
+use crate::ray::{PreparedRay, Ray};
 use crate::shading::bsdf::Bsdf;
 use crate::shading::material::Material;
 use crate::shading::surface;
@@ -149,6 +149,18 @@ impl Scene {
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
         self.geometry.occluded(ray)
+    }
+
+    /// [`Scene::closest_hit`] of a ray prepared already.
+    #[inline]
+    pub fn closest_hit_prepared(&self, ray: &PreparedRay) -> Option<Hit> {
+        self.geometry.closest_hit_prepared(ray)
+    }
+
+    /// [`Scene::occluded`] of a ray prepared already.
+    #[inline]
+    pub fn occluded_prepared(&self, ray: &PreparedRay) -> bool {
+        self.geometry.occluded_prepared(ray)
     }
 
     /// [`Scene::closest_hit`] of each of `rays` (`out[i]` for `rays[i]`): coherent rays,

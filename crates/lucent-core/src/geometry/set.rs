@@ -31,12 +31,17 @@ impl Geometry {
 
     #[inline]
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
-        let r = PreparedRay::new(*ray);
-        let mut best = self.accel.closest_hit(&self.primitives, &r);
+        self.closest_hit_prepared(&PreparedRay::new(*ray))
+    }
+
+    /// [`Geometry::closest_hit`] of a ray prepared already.
+    #[inline]
+    pub fn closest_hit_prepared(&self, r: &PreparedRay) -> Option<Hit> {
+        let mut best = self.accel.closest_hit(&self.primitives, r);
         // (The emptiness test here: the search is not inlined, and most scenes have no
         // planes.)
         if !self.unbounded.is_empty() {
-            self.nearer_unbounded(&r, &mut best);
+            self.nearer_unbounded(r, &mut best);
         }
         best
     }
@@ -91,8 +96,13 @@ impl Geometry {
 
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let r = PreparedRay::new(*ray);
-        self.unbounded_occludes(&r) || self.accel.occluded(&self.primitives, &r)
+        self.occluded_prepared(&PreparedRay::new(*ray))
+    }
+
+    /// [`Geometry::occluded`] of a ray prepared already.
+    #[inline]
+    pub fn occluded_prepared(&self, r: &PreparedRay) -> bool {
+        self.unbounded_occludes(r) || self.accel.occluded(&self.primitives, r)
     }
 
     /// World-space `∂p/∂u`, `∂p/∂v` at `hit` (see [`Primitive::tangents`]).
