@@ -762,7 +762,7 @@ fn surface_points(p: &mut Paths, flat: [bool; W]) {
     let error = scale(add(add(abs(a), abs(b)), abs(c)), _mm256_set1_ps(gamma(8)));
     let ng = normalize(cross(sub(p1, p0), sub(p2, p0)));
     // Whole stores of blends from two sources (a store of a blend with the old contents
-    // becomes a masked store, which Zen 4 runs in microcode: a tenth of the render).
+    // becomes a masked store, which Zen 4 runs in microcode).
     let o = &p.other_shape;
     let (point, error, ng, n) = (
         select(flat, point, load3(&o.point)),
