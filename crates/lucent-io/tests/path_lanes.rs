@@ -3,7 +3,8 @@
 //! same colour to the bit, and the same rays traced, for every camera sample of scenes
 //! with every kind of vertex the lanes meet (flat and smooth-shaded triangles, spheres
 //! and ellipsoids, black surfaces, lights seen directly and found by bounces, rays that
-//! escape), with both ways of drawing the next direction and several depths.
+//! escape), with both ways of drawing the next direction, several depths and Russian
+//! roulette on and off.
 
 use lucent_core::integrator::{CameraHit, TraceCounts};
 use lucent_core::math::Color;
@@ -12,13 +13,14 @@ use lucent_io::session::{Session, SessionOptions};
 
 /// An open box (no front wall) with two boxes of spheres, a smooth-shaded wedge, a black
 /// panel and two quad lights, one of them facing the camera.
-fn scene(sampling: &str, depth: i32) -> String {
+fn scene(sampling: &str, depth: i32, roulette: &str) -> String {
     format!(
         "size 20 16
 integrator pathtracer
 spp 3
 nexteventestimation mis
 importancesampling {sampling}
+russianroulette {roulette}
 maxdepth {depth}
 camera 0 1 3 0 1 0 0 1 0 50
 quadLight -0.25 1.999 -0.25 0 0 0.5 0.5 0 0 30 26 21
@@ -144,13 +146,21 @@ fn the_lanes_give_every_paths_bits(text: &str) {
 #[test]
 fn cosine_sampled_paths_in_lanes_are_the_one_path_code_bit_for_bit() {
     for depth in [1, 3, 7] {
-        the_lanes_give_every_paths_bits(&scene("cosine", depth));
+        the_lanes_give_every_paths_bits(&scene("cosine", depth, "off"));
     }
 }
 
 #[test]
 fn brdf_sampled_paths_in_lanes_are_the_one_path_code_bit_for_bit() {
     for depth in [0, 2, 5] {
-        the_lanes_give_every_paths_bits(&scene("brdf", depth));
+        the_lanes_give_every_paths_bits(&scene("brdf", depth, "off"));
+    }
+}
+
+#[test]
+fn paths_ended_by_russian_roulette_in_lanes_are_the_one_path_code_bit_for_bit() {
+    // Unbounded (ended by the roulette alone) and bounded depths, both samplings.
+    for (sampling, depth) in [("cosine", -1), ("brdf", -1), ("cosine", 4), ("brdf", 2)] {
+        the_lanes_give_every_paths_bits(&scene(sampling, depth, "on"));
     }
 }

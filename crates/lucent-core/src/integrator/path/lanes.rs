@@ -1,6 +1,6 @@
 //! The path tracer's paths eight at a time, in the lanes of AVX2 vectors, for the scenes
 //! whose every surface scatters the same simple way: `nexteventestimation mis`,
-//! `importancesampling cosine` or `brdf`, no Russian roulette, quad lights only, and
+//! `importancesampling cosine` or `brdf` (Russian roulette on or off), quad lights only, and
 //! Lambertian materials (`brdf phong` with `specular 0`, no maps, no emission, no glass).
 //!
 //! Eight paths go together, bounce by bounce: each path's segment is traced and its hit
@@ -35,9 +35,7 @@ const W: usize = 8;
 /// Whether the scene and settings are ones the lanes render (see the module's docs) on
 /// this CPU.
 pub(super) fn applies(pt: &PathTracer, scene: &Scene) -> bool {
-    let settings = pt.nee == Nee::Mis
-        && matches!(pt.sampling, DirectionSampling::Cosine | DirectionSampling::Brdf)
-        && !pt.russian_roulette;
+    let settings = pt.nee == Nee::Mis && matches!(pt.sampling, DirectionSampling::Cosine | DirectionSampling::Brdf);
     settings && scene.lambertian_and_quad_lit() && std::is_x86_feature_detected!("avx2")
 }
 
@@ -248,7 +246,9 @@ struct LightLanes {
 /// The next segment of each lane.
 #[derive(Default)]
 struct BounceLanes {
-    /// Whether the path goes on.
+    /// Whether a direction was found (above both surfaces, of positive density), and
+    /// whether the path goes on with it (a finite throughput that is not black).
+    valid: [bool; W],
     on: [bool; W],
     pdf: L,
     beta: L3,
@@ -436,7 +436,20 @@ fn run(
         unsafe { bounces(&mut paths) };
         for i in (0..W).filter(|&i| shading[i]) {
             let b = &paths.bounce;
-            if b.on[i] {
+            // Russian roulette (`go_on`), lane by lane, on the paths whose bounce found
+            // a direction; without it the lanes have decided already.
+            let on = if pt.russian_roulette && b.valid[i] {
+                let mut beta = b.beta.get(i);
+                let last = !pt.within_depth(k[i] + 1);
+                pt.go_on(&mut beta, last, &mut samplers[sample[i]]) && {
+                    paths.bounce.beta.set(i, beta);
+                    true
+                }
+            } else {
+                b.on[i]
+            };
+            let b = &paths.bounce;
+            if on {
                 paths.beta.set(i, b.beta.get(i));
                 paths.came_pdf[i] = b.pdf.0[i];
                 let ray = b.ray.get(i);
@@ -887,6 +900,7 @@ fn bounces(p: &mut Paths) {
         _mm256_or_ps(nonzero(beta.x), _mm256_or_ps(nonzero(beta.y), nonzero(beta.z))),
     );
     let b = &mut p.bounce;
+    b.valid = mask(valid);
     b.on = mask(on);
     store(&mut b.pdf, pdf);
     store3(&mut b.beta, beta);
