@@ -173,7 +173,7 @@ impl SurfacePoint {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -187,6 +187,26 @@ mod tests {
 
     #[test]
     fn a_whole_vector_steps_as_each_component_does() {
+        let (values, offsets) = ulp_step_cases();
+        for (i, &m) in values.iter().enumerate() {
+            for (j, &o) in offsets.iter().enumerate() {
+                let (m3, o3) = (
+                    Vec3A::new(m, values[(i + 1) % values.len()], values[(i + 7) % values.len()]),
+                    Vec3A::new(o, offsets[(j + 3) % offsets.len()], offsets[(j + 5) % offsets.len()]),
+                );
+                let got = one_ulp_along(m3, o3);
+                for a in 0..3 {
+                    let want = one_ulp_toward(m3[a], o3[a]);
+                    assert_eq!(got[a].to_bits(), want.to_bits(), "{} along {}", m3[a], o3[a]);
+                }
+            }
+        }
+    }
+
+    /// Values to step one ulp (every kind of float: zeros, subnormals, the largest,
+    /// infinities, NaN, then 3,000 random bit patterns) and offsets whose signs say the
+    /// way: what the tests of every form of the step share.
+    pub(crate) fn ulp_step_cases() -> (Vec<f32>, [f32; 8]) {
         let special = [
             0.0,
             -0.0,
@@ -212,19 +232,7 @@ mod tests {
             x ^= x << 5;
             f32::from_bits(x)
         };
-        let values: Vec<f32> = special.iter().copied().chain((0..3000).map(|_| random())).collect();
-        for (i, &m) in values.iter().enumerate() {
-            for (j, &o) in offsets.iter().enumerate() {
-                let (m3, o3) = (
-                    Vec3A::new(m, values[(i + 1) % values.len()], values[(i + 7) % values.len()]),
-                    Vec3A::new(o, offsets[(j + 3) % offsets.len()], offsets[(j + 5) % offsets.len()]),
-                );
-                let got = one_ulp_along(m3, o3);
-                for a in 0..3 {
-                    let want = one_ulp_toward(m3[a], o3[a]);
-                    assert_eq!(got[a].to_bits(), want.to_bits(), "{} along {}", m3[a], o3[a]);
-                }
-            }
-        }
+        let values = special.iter().copied().chain((0..3000).map(|_| random())).collect();
+        (values, offsets)
     }
 }

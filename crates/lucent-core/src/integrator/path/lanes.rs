@@ -1024,32 +1024,7 @@ mod tests {
             eprintln!("skipped: no AVX2 on this CPU");
             return;
         }
-        let special = [
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            f32::MIN_POSITIVE,
-            -f32::MIN_POSITIVE,
-            f32::from_bits(1),
-            -f32::from_bits(1),
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            1e-30,
-            -3.5e7,
-        ];
-        let offsets = [0.0, -0.0, 1e-6, -1e-6, 1.0, -1.0, f32::NAN, f32::INFINITY];
-        let mut x = 0x2545_f491u32;
-        let mut random = || {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            f32::from_bits(x)
-        };
-        let values: Vec<f32> = special.iter().copied().chain((0..4000).map(|_| random())).collect();
+        let (values, offsets) = crate::spawn::tests::ulp_step_cases();
         for (i, chunk) in values.chunks(W).enumerate() {
             let mut m = L::default();
             let mut o = L::default();
