@@ -1,18 +1,23 @@
 //! The path tracer's paths eight at a time, in the lanes of AVX2 vectors, for the scenes
 //! whose every surface scatters the same simple way: `nexteventestimation mis`,
-//! `importancesampling cosine` or `brdf` (Russian roulette on or off), quad lights only, and
-//! Lambertian materials (`brdf phong` with `specular 0`, no maps, no emission, no glass).
+//! `importancesampling cosine` or `brdf`, Russian roulette on or off, quad lights only,
+//! and Lambertian materials (`brdf phong` with `specular 0`, no maps, no emission, no
+//! glass).
 //!
-//! Eight paths go together, bounce by bounce: each path's segment is traced and its hit
-//! turned into a surface point one lane at a time (the BVH and the shapes' own code);
-//! then the light sample, the BSDF's value and density, the MIS weight's inputs, the next
-//! direction and the rays' offset origins are computed for all eight at once; the shadow
-//! rays are traced one lane at a time again. Every number is the one
-//! [`PathTracer::radiance`] computes for that path: the same operations in the same
-//! order, lane by lane (IEEE arithmetic gives the same bits in a vector lane as in a
-//! scalar register; the azimuth's sine and cosine are the same polynomial,
-//! `warp::sin_cos_turns`), and each path draws from its own sampler in the same order. A test compares the two on scenes of
-//! every shape.
+//! Eight paths go together, bounce by bounce. Each path's segment is traced one lane at
+//! a time (the BVH), and what it finds is looked at there: a light, or the surface point
+//! of any shape but a flat triangle. Then, for all eight at once: the flat triangles'
+//! surface points, the light sample, the BSDF's value and densities, the MIS weight, the
+//! next direction, the offset origins and the rays' traversal constants. The shadow rays
+//! are traced, and Russian roulette is played, one lane at a time again. A lane whose
+//! path ends takes the batch's next camera sample.
+//!
+//! Every number is the one [`PathTracer::radiance`] computes for that path: the same
+//! operations in the same order, lane by lane (IEEE arithmetic gives the same bits in a
+//! vector lane as in a scalar register; glam's order of operations is followed, and the
+//! azimuth's sine and cosine are the same polynomial, `warp::sin_cos_turns`), and each
+//! path draws from its own sampler in the same order. `tests/path_lanes.rs` compares the
+//! two, sample by sample, bit for bit.
 
 use std::arch::x86_64::*;
 use std::f32::consts::FRAC_1_PI;
