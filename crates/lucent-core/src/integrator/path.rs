@@ -29,8 +29,9 @@
 //! roulette, when about to go on, ends the path with probability `q = 1 − min(1, max(β))` and divides β by `1 − q` otherwise.
 //!
 //! The camera samples of a batch are taken one path at a time, or eight at a time in
-//! vector lanes ([`lanes`]) for Lambertian scenes lit by quad lights (the course's
-//! `cornellNEE` and dragon): the same numbers either way.
+//! vector lanes ([`lanes`]) for Lambertian scenes lit by quad lights with MIS (such as
+//! the diffuse versions of the course's Cornell box and dragon that the comparison with
+//! Mitsuba renders): the same numbers either way.
 
 #[cfg(target_arch = "x86_64")]
 mod lanes;
