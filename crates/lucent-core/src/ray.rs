@@ -70,13 +70,6 @@ pub struct PreparedRay {
     pub sz: f32,
 }
 
-impl Default for PreparedRay {
-    /// A ray from the origin along +z: a placeholder in arrays filled later.
-    fn default() -> PreparedRay {
-        PreparedRay::new(Ray::new(Vec3A::ZERO, Vec3A::Z))
-    }
-}
-
 impl PreparedRay {
     /// The same ray with another far limit (what a structure inside a primitive is asked).
     #[inline(always)]

@@ -79,8 +79,6 @@ struct Paths {
     /// The density of the BSDF sample that made each path's current segment.
     came_pdf: [f32; W],
     rays: [Option<Ray>; W],
-    /// Past the camera, the same rays prepared for traversal.
-    prepared: [PreparedRay; W],
     // A flat triangle's corners and the hit's barycentric weights, for the lanes whose
     // vertex is on one.
     p0: L3,
@@ -341,7 +339,7 @@ fn run(
             let hit = if first {
                 camera_hits[sample[i]]
             } else {
-                scene.closest_hit_prepared(&paths.prepared[i])
+                scene.closest_hit_prepared(&paths.bounce.ray.get(i))
             };
             paths.rays[i] = None;
             // A segment that escapes finds nothing (no environment here).
@@ -457,9 +455,7 @@ fn run(
             if on {
                 paths.beta.set(i, b.beta.get(i));
                 paths.came_pdf[i] = b.pdf.0[i];
-                let ray = b.ray.get(i);
-                paths.rays[i] = Some(ray.ray);
-                paths.prepared[i] = ray;
+                paths.rays[i] = Some(Ray::new(b.ray.origin.get(i), b.ray.dir.get(i)));
                 k[i] += 1;
             }
         }
