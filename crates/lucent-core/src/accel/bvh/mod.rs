@@ -17,6 +17,7 @@
 mod binary;
 mod box_test;
 mod build_ref;
+mod collapse_plan;
 mod lanes;
 mod packet;
 mod packet_frustum;

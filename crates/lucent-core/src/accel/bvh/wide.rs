@@ -1,16 +1,18 @@
 //! Second stage of the BVH build: the binary tree collapsed into 8-wide nodes.
 //!
-//! Each wide node takes the place of a binary node and adopts its descendants: it starts
-//! with the two children and keeps opening the child with the largest surface area until
-//! it has eight (or only leaves are left); a child subtree of at most eight primitives
-//! becomes one leaf (of at most two packets) instead of a node. The node stores its
-//! children's boxes as structure-of-arrays, so one AVX instruction (or two SSE ones)
-//! tests all eight. Leaves become runs of four-wide packets, laid out in the order
-//! traversal meets them. With more than one thread, large subtrees are laid out by
-//! tasks of their own, each as parts in the one-thread order, put together at the end;
-//! the packets are filled on the pool's threads: the same tree for any number of threads.
+//! Each wide node takes the place of a binary node and adopts the roots of a cut through
+//! its subtree as its (up to eight) children; each child is a leaf (a subtree of at most
+//! eight primitives, one or two packets) or a wide node of its own. Which cut, and which
+//! subtrees become leaves, is the plan of [`super::collapse_plan`]: the least expected
+//! cost by the surface area heuristic. The node stores its children's boxes as
+//! structure-of-arrays, so one AVX instruction (or two SSE ones) tests all eight. Leaves
+//! become runs of four-wide packets, laid out in the order traversal meets them. With
+//! more than one thread, large subtrees are laid out by tasks of their own, each as parts
+//! in the one-thread order, put together at the end; the packets are filled on the
+//! pool's threads: the same tree for any number of threads.
 
 use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
+use super::collapse_plan::{Plan, MERGE};
 use super::packet::{Packet, LANES};
 use crate::accel::PrimitiveSet;
 
@@ -76,6 +78,8 @@ pub fn levels(nodes: &[WideNode]) -> usize {
 
 pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
     let threads = rayon::current_num_threads();
+    let plan = Plan::new(tree);
+    let plan = &plan;
     let parts = match tree.nodes.first() {
         None => vec![],
         // A lone leaf still gets a node above it: traversal starts at a node.
@@ -93,13 +97,13 @@ pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideT
         }
         Some(_) if threads == 1 => {
             let mut part = Part::with_capacity(tree.nodes.len() / 4 + 1, tree.refs.len() / 3 + 1);
-            collapse_node(tree, 0, &mut part);
+            collapse_node(tree, plan, 0, &mut part);
             vec![part]
         }
         Some(_) => {
             // Enough tasks to keep every thread busy, few enough that parts stay large.
             let parallel = PARALLEL_REFS.max(tree.refs.len() / (8 * threads));
-            collapse_parallel(tree, 0, parallel)
+            collapse_parallel(tree, plan, 0, parallel)
         }
     };
     let (nodes, packet_refs) = join_parts(parts);
@@ -162,17 +166,17 @@ fn subtree_refs(tree: &BinaryTree, n: u32) -> usize {
 /// The wide subtree standing for interior binary node `b` as consecutive parts: the
 /// nodes and packets of [`collapse_node`], in its order, with large child subtrees
 /// collapsed on the pool's threads.
-fn collapse_parallel(tree: &BinaryTree, b: u32, parallel: usize) -> Vec<Part> {
+fn collapse_parallel(tree: &BinaryTree, plan: &Plan, b: u32, parallel: usize) -> Vec<Part> {
     let refs = subtree_refs(tree, b);
     if refs <= parallel {
         // About one node for every six references, one packet for every three.
         let mut part = Part::with_capacity(refs / 6 + 1, refs / 3 + 1);
-        collapse_node(tree, b, &mut part);
+        collapse_node(tree, plan, b, &mut part);
         return vec![part];
     }
-    let (children, count) = open_children(tree, b);
+    let (children, count) = plan.children(tree, b);
     let children = &children[..count];
-    let leaves: Vec<Option<(u32, u32)>> = children.iter().map(|&c| leaf_refs(tree, c)).collect();
+    let leaves: Vec<Option<(u32, u32)>> = children.iter().map(|&c| leaf_refs(tree, plan, c)).collect();
     let subtrees: Vec<Vec<Part>> = {
         use rayon::prelude::*;
         let interior: Vec<u32> = (children.iter().zip(&leaves))
@@ -180,7 +184,7 @@ fn collapse_parallel(tree: &BinaryTree, b: u32, parallel: usize) -> Vec<Part> {
             .collect();
         interior
             .par_iter()
-            .map(|&c| collapse_parallel(tree, c, parallel))
+            .map(|&c| collapse_parallel(tree, plan, c, parallel))
             .collect()
     };
     let mut subtrees = subtrees.into_iter();
@@ -304,11 +308,6 @@ fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u3
     node.child[slot] = reference;
 }
 
-/// A subtree with at most this many primitives becomes one leaf (of at most two packets)
-/// rather than a node of its own. Such subtrees are what is left over below a full
-/// node, and a node with two small leaves costs a visit that testing both packets
-/// outright does not (measured: 3–5% faster on the benchmark dragons; 12 is no better).
-const MERGE: u32 = 2 * LANES as u32;
 const _: () = assert!((MERGE as usize).div_ceil(LANES) <= 1 << (31 - PACKET_SHIFT));
 
 /// The references under binary node `n`, `(start, count)` (a subtree's references are
@@ -342,56 +341,26 @@ fn leaf_slot(leaf: &BinaryNode, out: &mut Part) -> u32 {
     push_packets(start, count, out.packet_refs.len(), &mut out.packet_refs)
 }
 
-/// The references of child `c` if it becomes a leaf: a binary leaf, or a small subtree
-/// merged into one.
-fn leaf_refs(tree: &BinaryTree, c: u32) -> Option<(u32, u32)> {
+/// The references of child `c` if it becomes a leaf: a binary leaf, or a subtree the
+/// plan merges into one.
+fn leaf_refs(tree: &BinaryTree, plan: &Plan, c: u32) -> Option<(u32, u32)> {
     match tree.nodes[c as usize].kind {
         Kind::Leaf { start, count } => Some((start, count)),
-        Kind::Interior { .. } => small_subtree(tree, c),
+        Kind::Interior { .. } if plan.is_leaf(c) => small_subtree(tree, c),
+        Kind::Interior { .. } => None,
     }
-}
-
-/// The children of the wide node standing for interior binary node `b` (and how many):
-/// its two children, then, while there are fewer than eight, the interior child with
-/// the largest surface area opened into its two.
-fn open_children(tree: &BinaryTree, b: u32) -> ([u32; WIDTH], usize) {
-    let Kind::Interior { left, right } = tree.nodes[b as usize].kind else {
-        unreachable!("interior")
-    };
-    let mut children = [0u32; WIDTH];
-    (children[0], children[1]) = (left, right);
-    let mut count = 2;
-    while count < WIDTH {
-        let widest = children[..count]
-            .iter()
-            .enumerate()
-            .filter(|(_, &c)| matches!(tree.nodes[c as usize].kind, Kind::Interior { .. }))
-            .max_by(|(_, &a), (_, &c)| {
-                let area = |n: u32| tree.nodes[n as usize].bounds.surface_area();
-                area(a).total_cmp(&area(c))
-            })
-            .map(|(i, _)| i);
-        let Some(i) = widest else { break };
-        let Kind::Interior { left, right } = tree.nodes[children[i] as usize].kind else {
-            unreachable!()
-        };
-        children.copy_within(i + 1..count, i + 2);
-        (children[i], children[i + 1]) = (left, right);
-        count += 1;
-    }
-    (children, count)
 }
 
 /// Builds the wide node standing for interior binary node `b`, its subtree after it;
 /// returns its index.
-fn collapse_node(tree: &BinaryTree, b: u32, out: &mut Part) -> u32 {
-    let (children, count) = open_children(tree, b);
+fn collapse_node(tree: &BinaryTree, plan: &Plan, b: u32, out: &mut Part) -> u32 {
+    let (children, count) = plan.children(tree, b);
     let me = out.nodes.len();
     out.nodes.push(WideNode::EMPTY);
     for (slot, &c) in children[..count].iter().enumerate() {
-        let reference = match leaf_refs(tree, c) {
+        let reference = match leaf_refs(tree, plan, c) {
             Some((start, n)) => push_packets(start, n, out.packet_refs.len(), &mut out.packet_refs),
-            None => byte_offset(collapse_node(tree, c, out) as usize),
+            None => byte_offset(collapse_node(tree, plan, c, out) as usize),
         };
         set_child(&mut out.nodes[me], slot, &tree.nodes[c as usize], reference);
     }
