@@ -151,7 +151,9 @@ fn combine(area: f32, l: &Summary, r: &Summary) -> (Summary, Decision) {
     for j in 2..=slots {
         for k in j.saturating_sub(r.slots).max(1)..=(j - 1).min(l.slots) {
             let c = l.cost[k - 1] + r.cost[j - k - 1];
-            if c < shared[j] {
+            // (The first candidate is kept even when every cost is infinite: boxes whose
+            // areas overflow `f32` still get a valid cut.)
+            if c < shared[j] || shared_split[j] == 0 {
                 shared[j] = c;
                 shared_split[j] = k as u8;
             }
@@ -171,7 +173,7 @@ fn combine(area: f32, l: &Summary, r: &Summary) -> (Summary, Decision) {
     let mut cost = [0.0; WIDTH];
     let mut split = [0u8; WIDTH];
     cost[0] = as_node.min(as_leaf);
-    split[0] = (as_leaf > as_node) as u8;
+    split[0] = (prims > MERGE || as_leaf > as_node) as u8;
     for i in 2..=WIDTH {
         if shared[i] < cost[i - 2] {
             cost[i - 1] = shared[i];
@@ -272,17 +274,30 @@ mod tests {
 
     #[test]
     fn every_primitive_is_in_exactly_one_child_of_each_node() {
-        let tree = binary::build(boxes(500).into_iter());
-        let plan = Plan::new(&tree);
+        // Also with boxes so large that their areas overflow to infinity.
+        for scale in [1.0, 1e30] {
+            let scaled = boxes(500).into_iter().map(|(i, b)| {
+                let b = crate::aabb::Aabb {
+                    min: b.min * scale,
+                    max: b.max * scale,
+                };
+                (i, b)
+            });
+            check_cuts(&binary::build(scaled));
+        }
+    }
+
+    fn check_cuts(tree: &BinaryTree) {
+        let plan = Plan::new(tree);
         let mut pending = vec![0u32];
         while let Some(n) = pending.pop() {
-            let (children, count) = plan.children(&tree, n);
+            let (children, count) = plan.children(tree, n);
             assert!((2..=WIDTH).contains(&count));
-            let total: u32 = children[..count].iter().map(|&m| prims(&tree, m)).sum();
-            assert_eq!(total, prims(&tree, n));
+            let total: u32 = children[..count].iter().map(|&m| prims(tree, m)).sum();
+            assert_eq!(total, prims(tree, n));
             for &m in &children[..count] {
                 if plan.is_leaf(m) {
-                    assert!(prims(&tree, m) <= MERGE || matches!(tree.nodes[m as usize].kind, Kind::Leaf { .. }));
+                    assert!(prims(tree, m) <= MERGE || matches!(tree.nodes[m as usize].kind, Kind::Leaf { .. }));
                 } else {
                     pending.push(m);
                 }
