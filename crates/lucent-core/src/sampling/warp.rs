@@ -17,8 +17,8 @@ fn spherical(cos_t: f32, v: f32) -> Vec3A {
 /// Taylor coefficients of `sin 2πr` in odd powers of `r` (from r¹) and of `cos 2πr` in
 /// even powers (from r²): on |r| ≤ 1/8 the first left out is below 2·10⁻⁹, under a
 /// thirtieth of an `f32` ulp of the results there.
-pub const SIN_TURN: [f32; 5] = [6.283_185_3, -41.341_702, 81.605_25, -76.705_86, 42.058_694];
-pub const COS_TURN: [f32; 5] = [-19.739_208, 64.939_394, -85.456_82, 60.244_64, -26.426_257];
+pub const SIN_TURN: [f32; 5] = [std::f32::consts::TAU, -41.341_7, 81.605_25, -76.705_86, 42.058_694];
+pub const COS_TURN: [f32; 5] = [-19.739_208, 64.939_39, -85.456_82, 60.244_64, -26.426_257];
 
 /// `(sin 2πv, cos 2πv)` for `v` in [0, 1], about as accurate as the C library's `sincosf`
 /// (a few ulps) and without its call: the nearest quarter turn `q` is taken off exactly

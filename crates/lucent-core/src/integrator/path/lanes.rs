@@ -33,8 +33,10 @@ use crate::sampler::Sampler;
 use crate::sampling::ONE_BELOW;
 use crate::scene::Scene;
 
+mod prepared;
 mod vector;
 
+use prepared::PreparedLanes;
 use vector::*;
 
 /// Whether the scene and settings are ones the lanes render (see the module's docs) on
