@@ -10,7 +10,7 @@
 //!
 //! | floor | modules |
 //! |---|---|
-//! | 0 base | [`math`], [`pow`], [`huge_pages`], [`transform`], [`ray`], [`aabb`], [`hit`], [`spawn`], [`sampler`], [`sampling`] |
+//! | 0 base | [`math`], [`pow`], [`huge_pages`], [`transform`], [`ray`], [`aabb`], [`hit`], [`spawn`], [`sampler`], [`sampling`] (and `test_rng` for the tests) |
 //! | 1 shapes | [`shape`]: intersection routines, texture coordinates, tangents |
 //! | 2 acceleration | [`accel`]: structures over any [`accel::PrimitiveSet`] |
 //! | 3 geometry | [`geometry`]: primitives, meshes, instances, the primitive set |
@@ -32,6 +32,8 @@ pub mod ray;
 pub mod sampler;
 pub mod sampling;
 pub mod spawn;
+#[cfg(test)]
+pub(crate) mod test_rng;
 pub mod transform;
 
 pub mod shape;

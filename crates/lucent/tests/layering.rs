@@ -22,6 +22,7 @@ const CORE: Floors = &[
     ("aabb", 0),
     ("hit", 0),
     ("spawn", 0),
+    ("test_rng", 0),
     ("sampler", 0),
     ("sampling", 0),
     ("shape", 1),

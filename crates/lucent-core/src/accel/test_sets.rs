@@ -1,6 +1,7 @@
 //! What the structures' own tests are built over: a deterministic random number
-//! generator and a plain soup of triangles. (The cross-checks against brute force on
-//! every kind of primitive live on the geometry floor: `crate::geometry`.)
+//! generator (from [`crate::test_rng`]) and a plain soup of triangles. (The cross-checks
+//! against brute force on every kind of primitive live on the geometry floor:
+//! `crate::geometry`.)
 
 use super::PrimitiveSet;
 use crate::aabb::Aabb;
@@ -9,22 +10,7 @@ use crate::math::Vec3A;
 use crate::ray::PreparedRay;
 use crate::shape::triangle;
 
-pub struct Rng(pub u64);
-impl Rng {
-    pub fn next(&mut self) -> f32 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 40) as f32) / (1u64 << 24) as f32
-    }
-    pub fn range(&mut self, a: f32, b: f32) -> f32 {
-        a + (b - a) * self.next()
-    }
-    pub fn vec(&mut self, s: f32) -> Vec3A {
-        Vec3A::new(self.range(-s, s), self.range(-s, s), self.range(-s, s))
-    }
-}
+pub use crate::test_rng::Rng;
 
 /// Triangles given by their corners.
 pub struct Triangles(pub Vec<[Vec3A; 3]>);

@@ -178,6 +178,69 @@ fn rays_starting_on_a_surface_match_the_list() {
 }
 
 #[test]
+fn rays_leaving_a_huge_floor_match_the_list_and_never_find_it() {
+    // The CSE168 dragon's kind of floor: two triangles 2,000 units across near y = −5,
+    // under a soup, tilted by 0.01 so that their boxes have height (a ray leaving a flat
+    // box never enters it). Rays spawned from it going up find it again by the error of
+    // `t` unless its hits are checked against the bound, which every path must do alike:
+    // single rays on every structure and instruction set, four-triangle leaves, and
+    // packets of rays (fans from one point of the floor share their axes).
+    use crate::spawn::{barycentric_point, offset_origin};
+    let floor = [
+        [
+            Vec3A::new(-1000.0, -5.0, -1000.0),
+            Vec3A::new(1000.0, -4.99, 1000.0),
+            Vec3A::new(1000.0, -4.995, -1000.0),
+        ],
+        [
+            Vec3A::new(-1000.0, -5.0, -1000.0),
+            Vec3A::new(-1000.0, -4.995, 1000.0),
+            Vec3A::new(1000.0, -4.99, 1000.0),
+        ],
+    ];
+    let mut prims: Vec<Primitive> = floor
+        .iter()
+        .map(|&p| Primitive::new(Shape::Triangle { p, normals: None }, 0))
+        .collect();
+    prims.extend(soup(21, 1500));
+    let mut rng = Rng(2024);
+    let mut rays = Vec::new();
+    for k in 0..3200 {
+        let p = floor[k % 2];
+        let (b1, b2) = (rng.range(0.0, 0.02), rng.range(0.0, 0.02));
+        let (b1, b2) = if k % 2 == 0 {
+            (0.49 + b1, 0.01 + b2)
+        } else {
+            (0.01 + b1, 0.49 + b2)
+        };
+        let (point, error) = barycentric_point(p, b1, b2);
+        let up = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        let up = if up.y < 0.0 { -up } else { up };
+        if k % 16 == 0 {
+            // A fan, row by row, as a tile's shadow rays leave.
+            let (dx, dz) = (rng.range(-0.5, 0.5), rng.range(0.5, 1.0));
+            for y in 0..8 {
+                for x in 0..8 {
+                    let d = Vec3A::new(dx + x as f32 / 32.0, 0.3 + y as f32 / 12.0, dz).normalize();
+                    rays.push(Ray::segment(offset_origin(point, error, up, d), d, 1e-4, f32::INFINITY));
+                }
+            }
+        } else {
+            let d = Vec3A::new(rng.range(-1.0, 1.0), rng.range(0.01, 1.0), rng.range(-1.0, 1.0)).normalize();
+            rays.push(Ray::segment(offset_origin(point, error, up, d), d, 1e-4, f32::INFINITY));
+        }
+    }
+    check_against_list(&prims, &rays);
+    let list = PrimitiveList::new(&prims[..2]);
+    let again = rays
+        .iter()
+        .filter(|r| list.closest_hit(&prims[..2], &PreparedRay::new(**r)).is_some())
+        .count();
+    // Without the bound, 297 of these 15,800 rays found it.
+    assert_eq!(again, 0, "rays that found the floor they leave");
+}
+
+#[test]
 fn degenerate_inputs_match_the_list() {
     // Empty scene.
     let none: Vec<Primitive> = Vec::new();

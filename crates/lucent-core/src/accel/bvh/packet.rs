@@ -7,7 +7,10 @@
 //! the BVH agree exactly with the brute-force list. Lanes whose edge functions round to
 //! zero take the scalar path (and its f64 fallback). Non-triangle primitives (spheres)
 //! sit in a packet as a flagged index with NaN corners and are tested by the scalar
-//! primitive code; unused lanes hold NaN corners, which no test accepts.
+//! primitive code; unused lanes hold NaN corners, which no test accepts. So do large
+//! triangles, whose hits the scalar test checks against the bound on the error of `t`
+//! ([`triangle::checks_t_error`]; the SIMD forms leave that check out, which keeps them
+//! as fast as they were on fine meshes, where it never changes an answer).
 
 use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
@@ -15,7 +18,8 @@ use crate::ray::PreparedRay;
 use crate::shape::triangle;
 
 pub const LANES: usize = 4;
-/// Marks a lane whose primitive is not a triangle.
+/// Marks a lane whose primitive is not a triangle, or a triangle that
+/// [`triangle::checks_t_error`].
 const OTHER: u32 = 1 << 31;
 /// An unused lane (no high bit, so it is skipped by the `OTHER` check for free).
 const UNUSED: u32 = OTHER - 1;
@@ -40,7 +44,9 @@ impl Packet {
         };
         for (lane, &id) in ids.iter().enumerate() {
             match prims.triangle(id) {
-                Some(p) => {
+                // A triangle whose hits are checked against the bound on the error of `t`
+                // goes to its primitive's own (scalar) test, which makes that check.
+                Some(p) if !triangle::checks_t_error(p[0], p[1], p[2]) => {
                     for (corner, v) in p.iter().enumerate() {
                         for axis in 0..3 {
                             pk.p[corner][axis][lane] = v[axis];
@@ -48,7 +54,7 @@ impl Packet {
                     }
                     pk.ids[lane] = id;
                 }
-                None => pk.ids[lane] = id | OTHER,
+                _ => pk.ids[lane] = id | OTHER,
             }
         }
         pk
@@ -94,7 +100,25 @@ impl Packet {
             );
             Self::record(prims, Hit::new(t, self.ids[lane], b1, b2), t_max, best);
         }
-        for lane in Lanes(lanes.scalar) {
+        if lanes.scalar != 0 {
+            self.closest_scalar(prims, r, lanes.scalar, t_max, best);
+        }
+    }
+
+    /// The lanes the SIMD test leaves to scalar code: other primitives, large triangles
+    /// and edge cases. Out of line: inlined, this code took registers from the traversal
+    /// loop around it, which cost fine meshes (where such lanes are rare) 3 %.
+    #[cold]
+    #[inline(never)]
+    fn closest_scalar<P: PrimitiveSet + ?Sized>(
+        &self,
+        prims: &P,
+        r: &PreparedRay,
+        scalar: u32,
+        t_max: &mut f32,
+        best: &mut Option<Hit>,
+    ) {
+        for lane in Lanes(scalar) {
             let id = self.ids[lane];
             let hit = if id & OTHER != 0 {
                 prims.intersect(id & !OTHER, r, *t_max)
@@ -115,7 +139,14 @@ impl Packet {
         if lanes.mask != 0 {
             return true;
         }
-        Lanes(lanes.scalar).any(|lane| {
+        lanes.scalar != 0 && self.any_hit_scalar(prims, r, lanes.scalar, t_max)
+    }
+
+    /// [`Self::closest_scalar`] for any-hit queries.
+    #[cold]
+    #[inline(never)]
+    fn any_hit_scalar<P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, scalar: u32, t_max: f32) -> bool {
+        Lanes(scalar).any(|lane| {
             let id = self.ids[lane];
             if id & OTHER != 0 {
                 prims.occludes(id & !OTHER, r, t_max)
@@ -239,7 +270,8 @@ impl Packet {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LaneKind {
     Triangle(u32),
-    /// A primitive that is not a triangle: tested by the primitive's own code.
+    /// A primitive that is not a triangle, or a large triangle: tested by the primitive's
+    /// own code.
     Other(u32),
     Unused,
 }
