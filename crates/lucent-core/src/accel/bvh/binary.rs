@@ -1,8 +1,9 @@
 //! First stage of the BVH build: a binary tree by the binned surface area heuristic
 //! (Wald 2007), later collapsed into the wide tree ([`super::wide`]).
 //!
-//! At each node the primitive centroids are sorted into 16 bins along all three axes at
-//! once, the 15 candidate planes per axis are priced with
+//! At each node the primitive centroids are sorted into 32 bins (16 in nodes of at most
+//! 64 primitives) along all three axes at once, the candidate planes per axis are priced
+//! with
 //! `C_trav + (A_l·P(N_l) + A_r·P(N_r)) / A`, where `P(n) = ⌈n/4⌉` counts the four-wide
 //! packets a leaf of `n` primitives needs, and the node becomes a leaf when that is no
 //! cheaper than its own packets. (Only the planes between occupied bins are priced, and a
@@ -23,7 +24,8 @@
 //! writes every node in place.
 
 use super::build_ref::BuildRef;
-use super::sah_bins::{area, bin_node, cheapest_plane, packets, side_bounds, PARALLEL_BINNING};
+use super::sah_bins::{area, bin_node, cheapest_plane, packets, side_bounds, Bins, PARALLEL_BINNING};
+use super::sah_bins::{FEW_BINS, FEW_BINS_UP_TO, MANY_BINS};
 use crate::aabb::Aabb;
 use crate::math::Vec3A;
 
@@ -278,7 +280,23 @@ fn sah_split(refs: &mut [BuildRef], bounds: &Aabb, cb: &Aabb, depth: usize) -> O
     if small && !free_step && TRAVERSAL_COST >= packets(count) {
         return None;
     }
-    let (bins, scale) = bin_node(refs, cb);
+    if count <= FEW_BINS_UP_TO {
+        binned_split::<FEW_BINS>(refs, bounds, cb, small, free_step)
+    } else {
+        binned_split::<MANY_BINS>(refs, bounds, cb, small, free_step)
+    }
+}
+
+/// [`sah_split`] with `N` bins.
+fn binned_split<const N: usize>(
+    refs: &mut [BuildRef],
+    bounds: &Aabb,
+    cb: &Aabb,
+    small: bool,
+    free_step: bool,
+) -> Option<Split> {
+    let count = refs.len();
+    let (bins, scale): (Bins<N>, Vec3A) = bin_node(refs, cb);
     let (cost, axis, split_bin) = cheapest_plane(&bins, scale)?;
     let a = area(bounds.min, bounds.max);
     let step = if free_step { 0.0 } else { TRAVERSAL_COST };

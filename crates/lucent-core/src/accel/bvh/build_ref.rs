@@ -11,7 +11,7 @@ pub struct BuildRef {
     pub lo: [f32; 3],
     pub prim: u32,
     pub hi: [f32; 3],
-    /// The reference's bin along x, y and z at the last binning (4 bits each), so that
+    /// The reference's bin along x, y and z at the last binning (8 bits each), so that
     /// the partition reads its side instead of computing it again.
     pub(super) bins: u32,
 }
@@ -72,15 +72,15 @@ const _: () = assert!(
 );
 
 impl BuildRef {
-    /// Notes the reference's bins along x, y and z (each below 16).
+    /// Notes the reference's bins along x, y and z (each below 256).
     #[inline(always)]
     pub(super) fn set_bins(&mut self, b: [usize; 3]) {
-        self.bins = (b[0] | b[1] << 4 | b[2] << 8) as u32;
+        self.bins = (b[0] | b[1] << 8 | b[2] << 16) as u32;
     }
 
     /// The reference's bin along `axis` at the last binning.
     #[inline(always)]
     pub(super) fn bin(&self, axis: usize) -> usize {
-        (self.bins >> (4 * axis)) as usize & 0xf
+        (self.bins >> (8 * axis)) as usize & 0xff
     }
 }
