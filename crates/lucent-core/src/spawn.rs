@@ -14,7 +14,9 @@
 //! back onto the sphere). A spawned ray starts at the point moved along the geometric
 //! normal, past that bound, to the side its direction leaves by; the true surface is then
 //! certainly behind it. The ray keeps the format's `t > ε` (SCENE_FORMAT.md §4.2) on top,
-//! so the course images keep their meaning.
+//! so the course images keep their meaning. What the offset cannot cover is the error of
+//! the triangle test's own `t`, which grows with the triangle's size: hits on large
+//! triangles are checked against pbrt's bound on it (`shape::triangle::checks_t_error`).
 
 use crate::hit::SurfacePoint;
 use crate::math::{gamma, Affine3A, Vec3A};
