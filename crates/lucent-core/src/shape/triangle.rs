@@ -101,8 +101,8 @@ pub fn checks_t_error(p0: Vec3A, p1: Vec3A, p2: Vec3A) -> bool {
 /// A bound on the rounding error of the watertight test's `t` (PBR 4th ed. §6.8.4, the
 /// triangle's `δt`), from the sheared corners `x`, `y`, `z` (z already scaled by `sz`),
 /// the edge functions `e` and `1/det`. A computed `t` at or below it may be a hit behind
-/// the origin. Applied to the triangles [`checks_t_error`] picks. Every vector form of the
-/// test computes this with the same operations in the same order.
+/// the origin. Applied to the triangles [`checks_t_error`] picks, by this scalar test
+/// only: the BVH's SIMD tests hand those triangles to it.
 #[inline(always)]
 pub fn t_error_bound(x: [f32; 3], y: [f32; 3], z: [f32; 3], e: [f32; 3], inv_det: f32) -> f32 {
     let max_abs = |a: [f32; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());
@@ -165,8 +165,8 @@ mod tests {
     /// Rays spawned from random points of random triangles `size` units across, in random
     /// directions whose sine to the plane is log-uniform in [`min_sin`, 1], from those
     /// triangles that [`checks_t_error`] says `checked`: how many find the triangle they
-    /// leave although it lies behind them. `flat` puts the corners on the plane y = −5 (a floor: the
-    /// point's error across the plane is then tiny, the error of `t` is not).
+    /// leave although it lies behind them. `flat` puts the corners on the plane y = −5 (a
+    /// floor: the point's error across the plane is then tiny, the error of `t` is not).
     fn false_hits(size: f32, flat: bool, checked: bool, min_sin: f32, n: usize, seed: u64) -> usize {
         use crate::spawn::{barycentric_point, offset_origin};
         use crate::test_rng::Rng;
