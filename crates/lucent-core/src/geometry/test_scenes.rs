@@ -3,8 +3,8 @@
 
 use super::analytic::Sphere;
 use super::primitive::{Primitive, Shape};
-pub use crate::accel::test_sets::Rng;
 use crate::math::{Affine3A, Vec3, Vec3A};
+pub use crate::test_rng::Rng;
 
 pub fn soup(seed: u64, n: usize) -> Vec<Primitive> {
     let mut rng = Rng(seed);

@@ -130,7 +130,7 @@ mod tests {
             eprintln!("skipped: no AVX2 on this CPU");
             return;
         }
-        let mut rng = crate::accel::test_sets::Rng(0x9e37_79b9);
+        let mut rng = crate::test_rng::Rng(0x9e37_79b9);
         // Directions of every sign, along the axes (±0 components), on the diagonals
         // (ties between axes) and at random.
         let mut dirs = vec![Vec3A::X, -Vec3A::X, Vec3A::Y, -Vec3A::Y, Vec3A::Z, -Vec3A::Z];
