@@ -332,6 +332,29 @@ fn bench_rays_traces_a_ray_file_and_writes_the_answers() {
             answers(fs::read(dir.join("h.bin")).unwrap()),
             [(1.0, 0), (1.0, 1), (2.0, 2), miss, miss]
         );
+        // The renderer's queries (which also ask the cache for the hit's indices): the
+        // same answers.
+        let o = lucent(
+            &dir,
+            &[
+                "bench",
+                "rays",
+                "m.obj",
+                "r.bin",
+                "--accel",
+                accel,
+                "--reps",
+                "1",
+                "--prefetch-hits",
+                "--hits",
+                "p.bin",
+            ],
+        );
+        assert!(o.status.success(), "{accel}: {}", stderr(&o));
+        assert_eq!(
+            fs::read(dir.join("p.bin")).unwrap(),
+            fs::read(dir.join("h.bin")).unwrap()
+        );
 
         let o = lucent(
             &dir,

@@ -6,14 +6,22 @@
 //! `--hits` writes 8 bytes per ray: f32 `t` and u32 triangle index (`inf`/`0xffffffff`
 //! for a miss); with `--occluded` `t` is 0 for an occluded ray and `inf` for a free one.
 //! One warm-up pass, then R timed passes; the last line reports medians.
+//!
+//! The queries are those of Embree's `rtcIntersect1`/`rtcOccluded1`, which the harness
+//! times beside them: they answer `t` and the triangle and read nothing else of the hit.
+//! The renderer's queries also ask the cache for the hit triangle's indices, which its
+//! shading reads next ([`PrimitiveSet::prefetch`]); here no one reads them, so that
+//! request is left out unless `--prefetch-hits` asks for the renderer's queries.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
+use lucent_core::aabb::Aabb;
 use lucent_core::accel::bvh::{Bvh, Isa};
-use lucent_core::accel::{AccelKind, Accelerator};
+use lucent_core::accel::{AccelKind, Accelerator, PrimitiveSet};
 use lucent_core::geometry::mesh::TriangleMesh;
+use lucent_core::hit::Hit;
 use lucent_core::math::Vec3A;
 use lucent_core::ray::{PreparedRay, Ray};
 use lucent_io::obj::load_obj;
@@ -56,6 +64,44 @@ pub struct RaysBenchArgs {
     /// Write the answers here (8 bytes per ray).
     #[arg(long, value_name = "OUT.bin")]
     pub hits: Option<PathBuf>,
+    /// Ask the cache for each hit triangle's indices, as the renderer's queries do for
+    /// the shading that follows (by default left out: nothing here reads them, and
+    /// Embree's queries, timed beside these, do not read them either).
+    #[arg(long)]
+    pub prefetch_hits: bool,
+}
+
+/// The mesh as this benchmark's queries see it: the same triangles and the same tests,
+/// and a hit's indices asked for only with `--prefetch-hits` (see the module docs).
+struct Queried {
+    mesh: TriangleMesh,
+    prefetch_hits: bool,
+}
+
+impl PrimitiveSet for Queried {
+    fn count(&self) -> usize {
+        PrimitiveSet::count(&self.mesh)
+    }
+    fn bounds(&self, i: u32) -> Aabb {
+        PrimitiveSet::bounds(&self.mesh, i)
+    }
+    fn triangle(&self, i: u32) -> Option<[Vec3A; 3]> {
+        PrimitiveSet::triangle(&self.mesh, i)
+    }
+    #[inline(always)]
+    fn intersect(&self, i: u32, ray: &PreparedRay, t_max: f32) -> Option<Hit> {
+        PrimitiveSet::intersect(&self.mesh, i, ray, t_max)
+    }
+    #[inline(always)]
+    fn occludes(&self, i: u32, ray: &PreparedRay, t_max: f32) -> bool {
+        PrimitiveSet::occludes(&self.mesh, i, ray, t_max)
+    }
+    #[inline(always)]
+    fn prefetch(&self, i: u32) {
+        if self.prefetch_hits {
+            PrimitiveSet::prefetch(&self.mesh, i);
+        }
+    }
 }
 
 const RECORD: usize = 32;
@@ -92,7 +138,7 @@ fn read_rays(path: &std::path::Path) -> Result<Vec<Ray>, String> {
 
 /// One query: `(t, triangle)` as the answer file stores it.
 #[inline(always)]
-fn answer(accel: &dyn Accelerator<TriangleMesh>, prims: &TriangleMesh, ray: &Ray, occluded: bool) -> (f32, u32) {
+fn answer(accel: &dyn Accelerator<Queried>, prims: &Queried, ray: &Ray, occluded: bool) -> (f32, u32) {
     let ray = &PreparedRay::new(*ray);
     if occluded {
         if accel.occluded(prims, ray) {
@@ -110,7 +156,7 @@ fn answer(accel: &dyn Accelerator<TriangleMesh>, prims: &TriangleMesh, ray: &Ray
 
 /// [`answer`] for a run of rays, in packets ([`Bvh::closest_hits`]), one 8 × 8 tile of
 /// the ray files at a time, as the renderer traces a tile's rays.
-fn trace_packets(bvh: &Bvh, prims: &TriangleMesh, rays: &[Ray], out: &mut [(f32, u32)], occluded: bool) {
+fn trace_packets(bvh: &Bvh, prims: &Queried, rays: &[Ray], out: &mut [(f32, u32)], occluded: bool) {
     const TILE: usize = 64;
     let mut hits = [None; TILE];
     let mut blocked = [false; TILE];
@@ -150,6 +196,10 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     let mesh = load_obj(&args.mesh, &mut res)
         .map_err(|e| format!("{}: {e}", args.mesh.display()))?
         .mesh;
+    let mesh = &Queried {
+        mesh,
+        prefetch_hits: args.prefetch_hits,
+    };
     let rays = read_rays(&args.rays)?;
 
     let pool = rayon::ThreadPoolBuilder::new()
@@ -182,10 +232,10 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
             isa
         }
     };
-    let build = || -> Box<dyn Accelerator<TriangleMesh>> {
+    let build = || -> Box<dyn Accelerator<Queried>> {
         match kind {
-            AccelKind::Bvh => Box::new(Bvh::build_for(&mesh, isa)),
-            _ => kind.build(&mesh),
+            AccelKind::Bvh => Box::new(Bvh::build_for(mesh, isa)),
+            _ => kind.build(mesh),
         }
     };
     let mut build_times = Vec::new();
@@ -203,16 +253,16 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     if args.packets && kind != AccelKind::Bvh {
         return Err("--packets traces with the bvh".into());
     }
-    let packed = args.packets.then(|| build_pool.install(|| Bvh::build_for(&mesh, isa)));
+    let packed = args.packets.then(|| build_pool.install(|| Bvh::build_for(mesh, isa)));
     let trace = |answers: &mut [(f32, u32)]| {
         const CHUNK: usize = 4096;
         answers.par_chunks_mut(CHUNK).enumerate().for_each(|(c, out)| {
             let rays = &rays[c * CHUNK..];
             match &packed {
-                Some(bvh) => trace_packets(bvh, &mesh, &rays[..out.len()], out, args.occluded),
+                Some(bvh) => trace_packets(bvh, mesh, &rays[..out.len()], out, args.occluded),
                 None => {
                     for (a, ray) in out.iter_mut().zip(rays) {
-                        *a = answer(accel.as_ref(), &mesh, ray, args.occluded);
+                        *a = answer(accel.as_ref(), mesh, ray, args.occluded);
                     }
                 }
             }
@@ -246,13 +296,13 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
     println!(
         "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={}{} isa={isa:?} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
-        accel.memory_bytes() as f64 / mesh.indices.len().max(1) as f64,
+        accel.memory_bytes() as f64 / mesh.mesh.indices.len().max(1) as f64,
         rays.len(),
         kind.name(),
         if args.packets { "+packets" } else { "" },
         pool.current_num_threads(),
         args.build_threads,
-        mesh.indices.len(),
+        mesh.mesh.indices.len(),
     );
     Ok(())
 }
