@@ -297,7 +297,7 @@ unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r
     use box_test::Fused;
     use lanes::Avx;
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(b, prims, r, &Fused::prepare(&RayBoxes::new(r), &offsets))
+        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(b, prims, r, &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes))
     } else {
         run_avx2_plain::<Q, P>(b, prims, r)
     }
@@ -314,9 +314,9 @@ unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: 
     // (Made here, not passed in: a reference to it would make the common path store it.)
     let rb = RayBoxes::new(r);
     if r.zero_axes.any() {
-        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
+        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
     } else {
-        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
+        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
     }
 }
 
@@ -329,14 +329,14 @@ unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P
     match b.isa {
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 if zero => {
-            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
+            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
         }
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb))
+            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
         }
-        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb)),
-        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb)),
+        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes)),
+        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes)),
     }
 }
 
@@ -350,9 +350,9 @@ unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
     match b.isa {
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb))
+            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
         }
-        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb)),
+        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes)),
     }
 }
 
