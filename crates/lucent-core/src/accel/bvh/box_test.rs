@@ -238,7 +238,7 @@ pub type Slab<L> = Planes<L, Subtract>;
 pub type Fused<L> = Planes<L, MulSub>;
 
 impl<L: Lanes> Slab<L> {
-    /// For tests of the nodes in `nodes` only.
+    /// The prepared ray tests nodes of `nodes` only.
     #[inline(always)]
     pub unsafe fn prepare(r: &RayBoxes, nodes: &[WideNode]) -> PlaneLanes<L> {
         PlaneLanes::new(r, [r.inv_dir, r.origin, r.inv_far, r.origin], nodes)
@@ -246,7 +246,7 @@ impl<L: Lanes> Slab<L> {
 }
 
 impl<L: FusedLanes> Fused<L> {
-    /// `offsets` must come from the same ray; for tests of the nodes in `nodes` only.
+    /// `offsets` must come from the same ray; the prepared ray tests nodes of `nodes` only.
     #[inline(always)]
     pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets, nodes: &[WideNode]) -> PlaneLanes<L> {
         PlaneLanes::new(r, [r.inv_dir, offsets.near, offsets.inv_far, offsets.far], nodes)
@@ -386,30 +386,19 @@ pub(super) mod tests {
             let pr = PreparedRay::new(r);
             let rb = RayBoxes::new(&pr);
             let zero = pr.zero_axes.any();
+            let one = std::slice::from_ref(&node);
             // SAFETY: plain f32 runs anywhere; SSE2 is part of x86-64; AVX2 and FMA are
             // checked first.
             unsafe {
-                check::<Slab<f32>>(
-                    "scalar",
-                    &node,
-                    &r,
-                    &Slab::prepare(&rb, std::slice::from_ref(&node)),
-                    zero,
-                );
+                check::<Slab<f32>>("scalar", &node, &r, &Slab::prepare(&rb, one), zero);
                 #[cfg(target_arch = "x86_64")]
                 {
                     use super::super::lanes::{Avx, Sse};
-                    check::<Slab<Sse>>("sse", &node, &r, &Slab::prepare(&rb, std::slice::from_ref(&node)), zero);
+                    check::<Slab<Sse>>("sse", &node, &r, &Slab::prepare(&rb, one), zero);
                     if super::super::Isa::detect().has_avx2() {
-                        check::<Slab<Avx>>("avx", &node, &r, &Slab::prepare(&rb, std::slice::from_ref(&node)), zero);
+                        check::<Slab<Avx>>("avx", &node, &r, &Slab::prepare(&rb, one), zero);
                         if let Some(offsets) = FmaOffsets::new(&pr) {
-                            check::<Fused<Avx>>(
-                                "avx+fma",
-                                &node,
-                                &r,
-                                &Fused::prepare(&rb, &offsets, std::slice::from_ref(&node)),
-                                false,
-                            );
+                            check::<Fused<Avx>>("avx+fma", &node, &r, &Fused::prepare(&rb, &offsets, one), false);
                             fused += 1;
                         }
                     }
