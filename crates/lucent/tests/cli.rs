@@ -306,24 +306,16 @@ fn bench_rays_traces_a_ray_file_and_writes_the_answers() {
             .collect()
     };
     for accel in ["bvh", "kdtree", "grid", "octree", "list"] {
-        let o = lucent(
-            &dir,
-            &[
-                "bench",
-                "rays",
-                "m.obj",
-                "r.bin",
-                "--accel",
-                accel,
-                "--reps",
-                "2",
-                "--threads",
-                "1",
-                "--hits",
-                "h.bin",
-            ],
-        );
-        assert!(o.status.success(), "{accel}: {}", stderr(&o));
+        // `bench rays m.obj r.bin --accel ACCEL` with `options`.
+        let bench = |options: &[&str]| {
+            let o = lucent(
+                &dir,
+                &[&["bench", "rays", "m.obj", "r.bin", "--accel", accel], options].concat(),
+            );
+            assert!(o.status.success(), "{accel} {options:?}: {}", stderr(&o));
+            o
+        };
+        let o = bench(&["--reps", "2", "--threads", "1", "--hits", "h.bin"]);
         let line = String::from_utf8_lossy(&o.stdout).into_owned();
         assert!(line.starts_with("mrays_per_s=") && line.contains(" build_s=") && line.contains(" bytes_per_tri="));
         assert!(line.contains(" rays=5 hits=3 "), "{line}");
@@ -334,45 +326,13 @@ fn bench_rays_traces_a_ray_file_and_writes_the_answers() {
         );
         // The renderer's queries (which also ask the cache for the hit's indices): the
         // same answers.
-        let o = lucent(
-            &dir,
-            &[
-                "bench",
-                "rays",
-                "m.obj",
-                "r.bin",
-                "--accel",
-                accel,
-                "--reps",
-                "1",
-                "--prefetch-hits",
-                "--hits",
-                "p.bin",
-            ],
-        );
-        assert!(o.status.success(), "{accel}: {}", stderr(&o));
+        bench(&["--reps", "1", "--prefetch-hits", "--hits", "p.bin"]);
         assert_eq!(
             fs::read(dir.join("p.bin")).unwrap(),
             fs::read(dir.join("h.bin")).unwrap()
         );
 
-        let o = lucent(
-            &dir,
-            &[
-                "bench",
-                "rays",
-                "m.obj",
-                "r.bin",
-                "--accel",
-                accel,
-                "--occluded",
-                "--reps",
-                "1",
-                "--hits",
-                "o.bin",
-            ],
-        );
-        assert!(o.status.success(), "{accel}: {}", stderr(&o));
+        bench(&["--occluded", "--reps", "1", "--hits", "o.bin"]);
         let free = (inf, 0);
         assert_eq!(
             answers(fs::read(dir.join("o.bin")).unwrap()),
