@@ -8,7 +8,10 @@
 #   meshes: this script reuses its Embree 4 harness (embree4_bench), its CPU-time wrapper
 #   (lucent_cpu.py) and its ray files (WORK/<mesh>/{primary,diffuse,shadow}.{rays,ref}).
 # env: ROUNDS (default 3: runs of each peer, interleaved, order alternating), REPS (default 7),
-#      THREADS (default 1), BENCH (default ../shared/bench, for the default mesh)
+#      THREADS (default 1), BENCH (default ../shared/bench, for the default mesh),
+#      ISA=avx2 (both peers limited to AVX2, as on a CPU without AVX-512: lucent with
+#      `--isa avx2`, Embree with `max_isa=avx2` in its device config; then its 16-wide
+#      queries run as 8-wide ones)
 #
 # Prints, per mesh and ray set, the median over rounds [min-max] of Embree 4's 8- and 16-wide
 # packets and of lucent's packets, the ratio lucent / (Embree's faster packet width), and how
@@ -21,6 +24,12 @@ shift 2
 bench=${BENCH:-$here/../../shared/bench}
 meshes=("$@"); [ ${#meshes[@]} -gt 0 ] || meshes=("$bench/dragon_100k.obj")
 ROUNDS=${ROUNDS:-3}; REPS=${REPS:-7}; THREADS=${THREADS:-1}
+isa_args=(); eb_config=${EB_CONFIG:-}
+case ${ISA:-} in
+  "") ;;
+  avx2) isa_args=(--isa avx2); eb_config="${eb_config:+$eb_config,}max_isa=avx2" ;;
+  *) echo "compare_packets.sh: ISA=$ISA: only avx2 (or nothing: each peer's best)" >&2; exit 2 ;;
+esac
 for f in "$work/embree4_bench" "$work/lucent_cpu.py"; do
   [ -e "$f" ] || { echo "compare_packets.sh: $f is missing: run ../shared/bench/compare4.sh with WORK=$work first" >&2; exit 1; }
 done
@@ -37,13 +46,13 @@ for mesh in "${meshes[@]}"; do
     if (( r % 2 )); then order="e4 lucent"; else order="lucent e4"; fi
     for p in $order; do
       case $p in
-        e4) env EB_QUALS=medium EB_TRACE_QUALS=medium EB_MODES=8,16 EB_THREADS="$THREADS" EB_BUILD_THREADS=1 \
+        e4) env EB_CONFIG="$eb_config" EB_QUALS=medium EB_TRACE_QUALS=medium EB_MODES=8,16 EB_THREADS="$THREADS" EB_BUILD_THREADS=1 \
               "$work/embree4_bench" "$obj" "$d" "$REPS" > "$d/packets.embree4.r$r.tsv" 2>&1 ;;
         lucent)
           for set in primary diffuse shadow; do
             if [ $set = shadow ]; then occ=--occluded; else occ=; fi
             python3 "$work/lucent_cpu.py" "$lucent" bench rays "$obj" "$d/$set.rays" --reps "$REPS" --threads "$THREADS" \
-              --packets $occ --hits "$d/$set.lucent_packets" > "$d/packets.lucent.$set.r$r.txt" 2>&1 \
+              --packets $occ ${isa_args[@]+"${isa_args[@]}"} --hits "$d/$set.lucent_packets" > "$d/packets.lucent.$set.r$r.txt" 2>&1 \
               || echo "compare_packets.sh: lucent failed on $name/$set, see $d/packets.lucent.$set.r$r.txt" >&2
           done ;;
       esac
@@ -100,4 +109,5 @@ for name in names:
 print(f"\n(Mrays per CPU-second, {threads} thread(s), median of {rounds} interleaved rounds [min-max]; "
       f"ratio = lucent / the faster Embree packet width, paired by round; mismatches against the Embree 3 reference)")
 PY
+[ -z "${ISA:-}" ] || echo "Both peers limited to ${ISA}."
 echo "CPU: $(lscpu 2>/dev/null | sed -n 's/^Model name: *//p' | head -1); $(grep -o 'avx512[a-z_0-9]*' /proc/cpuinfo 2>/dev/null | sort -u | tr '\n' ' ')"
