@@ -1,7 +1,7 @@
-//! The box test of a BVH node visit: one ray against all eight child boxes at once (AVX
-//! when the CPU has it — detected at run time — else two SSE halves; the tests are
-//! written once over the lanes of [`super::lanes`]), giving which boxes it enters and
-//! at what distance.
+//! The box test of a BVH node visit: one ray against a node's sixteen child boxes, eight
+//! at a time with AVX when the CPU has it (detected at run time), else four at a time
+//! with SSE (the tests are written once over the lanes of [`super::lanes`]), giving which
+//! boxes it enters and at what distance.
 //!
 //! Every box test is conservative: it never rejects a box the exact slab test enters.
 //! * The SSE and scalar tests are the slab test of [`crate::aabb::Aabb::intersect`],
@@ -316,7 +316,7 @@ pub(super) mod tests {
         (near <= far).then_some(near)
     }
 
-    /// Eight boxes, and rays from near and far that graze their corners, edges and faces.
+    /// A node full of boxes, and rays from near and far that graze their corners, edges and faces.
     fn cases(rng: &mut Rng) -> impl Iterator<Item = (WideNode, Ray)> + '_ {
         (0..20_000).map(move |_| {
             let mut node = WideNode::EMPTY;

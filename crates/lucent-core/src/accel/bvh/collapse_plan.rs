@@ -3,7 +3,7 @@
 //! over the binary tree, after Ylitie, Karras and Laine (2017), "Efficient incoherent
 //! ray traversal on GPUs through compressed wide BVHs", section 4.
 //!
-//! A wide node standing for binary node `n` has up to eight children, each a binary
+//! A wide node standing for binary node `n` has up to sixteen children, each a binary
 //! node below `n`: the roots of a cut through `n`'s subtree. Each child is a leaf (a
 //! subtree of at most [`MERGE`] primitives, tested as packets of four) or a wide node of
 //! its own. `cost(n, i)` is the least cost of `n`'s subtree when it may take up to `i`
@@ -43,7 +43,7 @@ struct Summary {
     /// `cost[i - 1]`: the least cost with up to `i` slots.
     cost: [f32; WIDTH],
     prims: u32,
-    /// The most slots the subtree can fill (its binary leaves, at most eight): `cost` is
+    /// The most slots the subtree can fill (its binary leaves, at most sixteen): `cost` is
     /// the same from there on.
     slots: usize,
 }
@@ -194,6 +194,7 @@ mod tests {
     use super::super::binary;
     use super::super::sah_bins::tests::boxes;
     use super::*;
+    use std::collections::HashMap;
 
     fn area(tree: &BinaryTree, n: u32) -> f32 {
         tree.nodes[n as usize].bounds.surface_area()
@@ -223,23 +224,30 @@ mod tests {
     }
 
     /// The least cost of `n` as a child slot, by trying every cut below every node.
-    fn best_slot(tree: &BinaryTree, n: u32) -> f32 {
-        let leaf = match tree.nodes[n as usize].kind {
-            Kind::Leaf { count, .. } => return area(tree, n) * PACKET_COST * packets(count),
-            _ if prims(tree, n) <= MERGE => area(tree, n) * PACKET_COST * packets(prims(tree, n)),
-            _ => f32::INFINITY,
+    /// (Each node's least slot cost is found once: `memo`.)
+    fn best_slot(tree: &BinaryTree, n: u32, memo: &mut HashMap<u32, f32>) -> f32 {
+        if let Some(&c) = memo.get(&n) {
+            return c;
+        }
+        let c = match tree.nodes[n as usize].kind {
+            Kind::Leaf { count, .. } => area(tree, n) * PACKET_COST * packets(count),
+            _ if prims(tree, n) <= MERGE => {
+                (area(tree, n) * PACKET_COST * packets(prims(tree, n))).min(best_node(tree, n, memo))
+            }
+            _ => best_node(tree, n, memo),
         };
-        leaf.min(best_node(tree, n))
+        memo.insert(n, c);
+        c
     }
 
-    fn best_node(tree: &BinaryTree, n: u32) -> f32 {
+    fn best_node(tree: &BinaryTree, n: u32, memo: &mut HashMap<u32, f32>) -> f32 {
         let Kind::Interior { left, right } = tree.nodes[n as usize].kind else {
             unreachable!()
         };
         let mut best = f32::INFINITY;
         for a in cuts(tree, left, WIDTH - 1) {
             for b in cuts(tree, right, WIDTH - a.len()) {
-                let c: f32 = a.iter().chain(&b).map(|&m| best_slot(tree, m)).sum();
+                let c: f32 = a.iter().chain(&b).map(|&m| best_slot(tree, m, memo)).sum();
                 best = best.min(c);
             }
         }
@@ -264,7 +272,8 @@ mod tests {
         for n in [9, 17, 24, 33, 41] {
             let tree = binary::build(boxes(n).into_iter());
             let plan = Plan::new(&tree);
-            let (planned, best) = (planned_node(&plan, &tree, 0), best_node(&tree, 0));
+            let best = best_node(&tree, 0, &mut HashMap::new());
+            let planned = planned_node(&plan, &tree, 0);
             assert!(
                 (planned - best).abs() <= 1e-5 * best,
                 "{n} boxes: {planned} against {best}"

@@ -1,11 +1,11 @@
-//! Bounding volume hierarchy (`--accel bvh`, the default): an 8-wide BVH over packets
+//! Bounding volume hierarchy (`--accel bvh`, the default): a 16-wide BVH over packets
 //! of four triangles.
 //!
-//! Build ([`binary`], [`wide`]): a binned-SAH binary tree, collapsed into nodes of eight
+//! Build ([`binary`], [`wide`]): a binned-SAH binary tree, collapsed into nodes of sixteen
 //! children whose boxes are stored as structure-of-arrays; leaves become packets of four
 //! primitives with precomputed triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): eight box tests per visit ([`box_test`]) with AVX2 and FMA
+//! Traversal ([`traverse`]): sixteen box tests per visit, eight at a time ([`box_test`]), with AVX2 and FMA
 //! when the CPU has them (decided once, at build time, with `is_x86_feature_detected!`), two SSE
 //! halves when not; nearest child first, an explicit fixed-size stack, no allocation per
 //! ray; the packet test is bit-identical to the scalar watertight triangle test, so the answers
@@ -40,7 +40,7 @@ use wide::WideNode;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
     /// AVX-512 F, VL and BW (with AVX2 and FMA): packets of sixteen rays; single rays
-    /// take the 8-wide AVX2 code compiled for AVX-512 (see `run_avx512`).
+    /// take the AVX2 code (eight boxes at a time) compiled for AVX-512 (see `run_avx512`).
     Avx512,
     /// AVX2 with FMA (every AVX2 CPU has both): packets of eight rays.
     Avx2,
@@ -275,7 +275,7 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
     run_fused::<Q, P>(b, prims, r)
 }
 
-/// The same code as [`run_avx2`] (the same 8-wide operations, the same answers), compiled
+/// The same code as [`run_avx2`] (the same 8-lane operations, the same answers), compiled
 /// with AVX-512 VL: 32 vector registers, so the ray's constants stay in registers, and
 /// comparisons into mask registers. Measured on an AMD EPYC (Zen 4): closest hits
 /// 1.05–1.11× faster than the AVX2 build; any-hit queries were not (0.93–1.01×) until the
@@ -415,8 +415,8 @@ mod tests {
         let mut seen = bvh.leaf_prims();
         seen.sort_unstable();
         assert!(seen.iter().copied().eq(0..prims.0.len() as u32));
-        // A binary tree with leaves of up to four would need about n/2 nodes; eight-wide
-        // nodes need several times fewer.
+        // A binary tree with leaves of up to four would need about n/2 nodes; wide nodes
+        // need several times fewer.
         assert!(
             bvh.node_count() > 50 && bvh.node_count() < prims.0.len() / 6,
             "{}",
@@ -513,9 +513,9 @@ mod tests {
         let prims = Triangles::random(4, 20_000);
         let shallow = Bvh::build(&prims);
         let levels = wide::levels(&shallow.nodes);
-        // 20,000 triangles under nodes of eight whose leaves hold at most eight: at least
-        // 4 levels (8⁴ · 8 = 32,768), and SAH trees are not much deeper.
-        assert!((4..=12).contains(&levels), "{levels} levels");
+        // 20,000 triangles under nodes of sixteen whose leaves hold at most eight: at least
+        // 3 levels (16³ · 8 = 32,768), and SAH trees are not much deeper.
+        assert!((3..=10).contains(&levels), "{levels} levels");
         assert!(!shallow.deep);
         // The same tree through the large-stack path every ISA has.
         for isa in Isa::available() {

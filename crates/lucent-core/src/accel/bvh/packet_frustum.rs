@@ -1,11 +1,11 @@
-//! A packet's rays bounded by intervals, and the node test that culls a node's eight
+//! A packet's rays bounded by intervals, and the node test that culls a node's sixteen
 //! children for the whole packet at once (interval arithmetic, as in Wald, Boulos and
 //! Shirley, "Ray Tracing Deformable Scenes Using Dynamic Bounding Volume Hierarchies",
 //! 2007). When every ray of a packet moves the same way along each axis, all their
 //! origins lie in `[O_lo, O_hi]` and all their reciprocal directions in `[R_lo, R_hi]`
 //! (one sign) per axis; a child box that no ray in those intervals can enter is dropped
-//! with one eight-wide test, before [`super::ray_packet`] tests the boxes left ray by
-//! ray. Coherent packets (camera rays of a tile) enter one or two of a node's eight
+//! with two eight-wide tests, before [`super::ray_packet`] tests the boxes left ray by
+//! ray. Coherent packets (camera rays of a tile) enter one or two of a node's sixteen
 //! children, so most per-ray box tests are never made.
 //!
 //! **Conservative.** For ray `i` and a plane `b` along an axis its exact slab distance is
@@ -27,12 +27,12 @@
 
 use super::lanes::{Avx, Lanes};
 use super::ray_lanes::RayLanes;
-use super::wide::WideNode;
+use super::wide::{WideNode, WIDTH};
 
 /// The relative widening of the reciprocal directions' interval (see the module docs).
 const MARGIN: f32 = 1.0 / (1u32 << 20) as f32;
 
-/// A packet's rays as intervals, per axis, broadcast over a node's eight children.
+/// A packet's rays as intervals, per axis, broadcast over eight of a node's children.
 #[derive(Clone, Copy)]
 pub(super) struct Frustum {
     /// Rows of a node's bounds: the planes the rays enter and leave by.
@@ -78,19 +78,25 @@ impl Frustum {
 
     /// The child slots of `node` that some ray of the packet may enter before `limit`
     /// (bit `c` for slot `c`): a superset of the slots the rays' own box tests enter.
+    /// Their near bounds go to `bound` (eight slots at a time).
     #[inline(always)]
-    pub(super) unsafe fn children(&self, node: &WideNode, limit: f32) -> (u32, Avx) {
-        let mut near = Avx::splat(f32::NEG_INFINITY);
-        let mut far = Avx::splat(f32::INFINITY);
-        for a in 0..3 {
-            let (near_row, far_row) = self.rows[a];
-            let dn = Avx::load(node.bounds[near_row].as_ptr()).sub(self.near_origin[a]);
-            let df = Avx::load(node.bounds[far_row].as_ptr()).sub(self.far_origin[a]);
-            near = near.max(dn.mul(self.inv_lo[a]).min(dn.mul(self.inv_hi[a])));
-            far = far.min(df.mul(self.inv_lo[a]).max(df.mul(self.inv_hi[a])));
+    pub(super) unsafe fn children(&self, node: &WideNode, limit: f32, bound: &mut [f32; WIDTH]) -> u32 {
+        let mut mask = 0;
+        for first in (0..WIDTH).step_by(Avx::N) {
+            let mut near = Avx::splat(f32::NEG_INFINITY);
+            let mut far = Avx::splat(f32::INFINITY);
+            for a in 0..3 {
+                let (near_row, far_row) = self.rows[a];
+                let dn = Avx::load(node.bounds[near_row].as_ptr().add(first)).sub(self.near_origin[a]);
+                let df = Avx::load(node.bounds[far_row].as_ptr().add(first)).sub(self.far_origin[a]);
+                near = near.max(dn.mul(self.inv_lo[a]).min(dn.mul(self.inv_hi[a])));
+                far = far.min(df.mul(self.inv_lo[a]).max(df.mul(self.inv_hi[a])));
+            }
+            let enters = Avx::and(near.le(far), near.le(Avx::splat(limit)));
+            mask |= Avx::bits(Avx::and(enters, Avx::splat(0.0).le(far))) << first;
+            near.store(bound.as_mut_ptr().add(first));
         }
-        let enters = Avx::and(near.le(far), near.le(Avx::splat(limit)));
-        (Avx::bits(Avx::and(enters, Avx::splat(0.0).le(far))), near)
+        mask
     }
 }
 
@@ -98,14 +104,13 @@ impl Frustum {
 mod tests {
     use super::super::box_test::tests::exact_entry;
     use super::super::ray_lanes::{Rays16, Rays8};
-    use super::super::wide::WIDTH;
     use super::*;
     use crate::accel::search_limit;
     use crate::accel::test_sets::Rng;
     use crate::math::Vec3A;
     use crate::ray::Ray;
 
-    /// A node of eight random boxes and a packet of up to eight rays that all move the
+    /// A node of random boxes and a packet of up to eight rays that all move the
     /// same way along each axis, from origins spread over `spread`, aimed at the corners,
     /// edges and faces of the boxes (grazing them).
     fn case(rng: &mut Rng) -> (WideNode, Vec<Ray>) {
@@ -168,9 +173,8 @@ mod tests {
         let inv = [0, 1, 2].map(|a| lane(&|r: &Ray| 1.0 / r.dir[a]));
         let rows = [0, 1, 2].map(|a| if rays[0].dir[a] > 0.0 { (a, a + 3) } else { (a + 3, a) });
         let f = Frustum::new(&origin, &inv, rows, (1 << rays.len()) - 1);
-        let (mask, near) = f.children(node, limit);
         let mut bound = [0f32; WIDTH];
-        near.store(bound.as_mut_ptr());
+        let mask = f.children(node, limit, &mut bound);
         (mask, bound)
     }
 

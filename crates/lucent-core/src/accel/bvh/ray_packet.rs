@@ -2,7 +2,7 @@
 //! through the wide BVH together, one SIMD lane per ray: eight with AVX2, sixteen with
 //! AVX-512 ([`super::ray_lanes`]). At a node, when the rays all move the same way along
 //! each axis, the interval test of [`super::packet_frustum`] first drops the children no
-//! ray of the packet can enter (camera rays enter one or two of eight); a closest-hit
+//! ray of the packet can enter (camera rays enter one or two of sixteen); a closest-hit
 //! packet goes on into the inner nodes it keeps with all its rays. Each other child box
 //! is tested against every active ray of the packet; a child that some ray enters is
 //! pushed with the mask of those rays. At a leaf reached by several rays that share
@@ -27,7 +27,6 @@
 //! traced alone.
 
 use super::box_test::FmaOffsets;
-use super::lanes::Lanes as _;
 use super::packet::{LaneKind, Lanes as Bits, Packet};
 use super::packet_frustum::Frustum;
 use super::ray_lanes::RayLanes;
@@ -456,11 +455,7 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
         let base = sp;
         let mut bound = [0f32; WIDTH];
         let slots = match &lanes.frustum {
-            Some(f) => {
-                let (slots, near) = f.children(node, packet_limit);
-                near.store(bound.as_mut_ptr());
-                slots
-            }
+            Some(f) => f.children(node, packet_limit, &mut bound),
             None => (1 << WIDTH) - 1,
         };
         for c in Bits(slots) {

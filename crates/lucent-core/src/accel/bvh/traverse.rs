@@ -1,6 +1,6 @@
 //! Walking the wide BVH: closest-hit and any-hit queries.
 //!
-//! Each node visit tests the ray against all eight child boxes at once ([`super::box_test`]),
+//! Each node visit tests the ray against all sixteen child boxes ([`super::box_test`]),
 //! then continues with the nearest child and pushes the others, farthest first, on a
 //! fixed stack together with their entry distance; a popped entry that starts beyond the
 //! closest hit found since is dropped.
@@ -20,16 +20,16 @@ use crate::ray::PreparedRay;
 /// binary level. [`super::Bvh`] asserts it at build time.
 pub const MAX_LEVELS: usize = 112;
 /// The node levels of the trees the fast paths are compiled for: every tree a real scene
-/// makes (a billion triangles in balanced nodes of eight need 10). Deeper trees take the
-/// paths with [`DEEP_STACK`].
-pub const SHALLOW_LEVELS: usize = 32;
+/// makes (a billion triangles in balanced nodes of sixteen need 7; the dragons' trees
+/// have 7 and 9). Deeper trees take the paths with [`DEEP_STACK`].
+pub const SHALLOW_LEVELS: usize = 16;
 
 /// Stack entries for trees of `levels` node levels: each visit leaves at most
 /// `WIDTH - 1` entries for the levels below it.
 const fn stack_entries(levels: usize) -> usize {
     (WIDTH - 1) * levels
 }
-/// The stack of the fast paths: 1.8 KB. A stack sized for [`MAX_LEVELS`] (6 KB) made
+/// The stack of the fast paths: 1.9 KB. A stack sized for [`MAX_LEVELS`] (6 KB) made
 /// every query's frame span two pages, behind a stack probe, and made a query that
 /// misses everything about 30 % slower.
 pub const SHALLOW_STACK: usize = stack_entries(SHALLOW_LEVELS);

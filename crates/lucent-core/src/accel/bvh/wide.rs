@@ -1,11 +1,18 @@
-//! Second stage of the BVH build: the binary tree collapsed into 8-wide nodes.
+//! Second stage of the BVH build: the binary tree collapsed into 16-wide nodes.
 //!
 //! Each wide node takes the place of a binary node and adopts the roots of a cut through
-//! its subtree as its (up to eight) children; each child is a leaf (a subtree of at most
+//! its subtree as its (up to sixteen) children; each child is a leaf (a subtree of at most
 //! eight primitives, one or two packets) or a wide node of its own. Which cut, and which
 //! subtrees become leaves, is the plan of [`super::collapse_plan`]: the least expected
 //! cost by the surface area heuristic. The node stores its children's boxes as
-//! structure-of-arrays, so one AVX instruction (or two SSE ones) tests all eight. Leaves
+//! structure-of-arrays, so two AVX instructions (or four SSE ones) test all sixteen.
+//!
+//! Why sixteen: a single ray's walk waits, at every node, on the chain from loading a
+//! child's reference to choosing the next child, so fewer levels are fewer waits; the
+//! second group of eight boxes is tested beside the first, off that chain. Against
+//! nodes of eight (on an AMD EPYC, Zen 4, paired): single rays 1.01–1.07× faster on
+//! the dragons, packets of rays the same, the same memory per triangle (see
+//! `docs/performance.md`). Leaves
 //! become runs of four-wide packets, laid out in the order traversal meets them. With
 //! more than one thread, large subtrees are laid out by tasks of their own, each as parts
 //! in the one-thread order, put together at the end; the packets are filled on the
@@ -16,7 +23,7 @@ use super::collapse_plan::{Plan, MERGE};
 use super::packet::{Packet, LANES};
 use crate::accel::PrimitiveSet;
 
-pub const WIDTH: usize = 8;
+pub const WIDTH: usize = 16;
 /// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`;
 /// an interior child is the byte offset of its node in the node array.
 pub const LEAF: u32 = 1 << 31;
@@ -25,7 +32,7 @@ pub const FIRST_MASK: u32 = (1 << PACKET_SHIFT) - 1;
 /// An unused slot; its box is empty (min > max), so no ray ever enters it.
 pub const EMPTY: u32 = 0;
 
-/// Eight child boxes and references. `bounds[0..3]` are the minima along x, y, z,
+/// Sixteen child boxes and references. `bounds[0..3]` are the minima along x, y, z,
 /// `bounds[3..6]` the maxima; lane `i` belongs to child `i`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
