@@ -5,11 +5,12 @@
 //! children whose boxes are stored as structure-of-arrays; leaves become packets of four
 //! primitives with precomputed triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): sixteen box tests per visit, eight at a time ([`box_test`]), with AVX2 and FMA
-//! when the CPU has them (decided once, at build time, with `is_x86_feature_detected!`), two SSE
-//! halves when not; nearest child first, an explicit fixed-size stack, no allocation per
-//! ray; the packet test is bit-identical to the scalar watertight triangle test, so the answers
-//! are exactly the brute-force list's.
+//! Traversal ([`traverse`]): sixteen box tests per visit ([`box_test`]), eight at a time
+//! with AVX2 and FMA when the CPU has them (decided once, at build time, with
+//! `is_x86_feature_detected!`), four at a time with SSE when not; nearest child first,
+//! an explicit fixed-size stack, no allocation per ray; the packet test is bit-identical
+//! to the scalar watertight triangle test, so the answers are exactly the brute-force
+//! list's.
 //!
 //! Coherent rays can also travel in packets ([`ray_packet`]): eight rays with AVX2,
 //! sixteen with AVX-512 ([`Bvh::closest_hits`], [`Bvh::occluded_rays`]).

@@ -37,6 +37,7 @@ pub const DEEP_STACK: usize = stack_entries(MAX_LEVELS);
 
 /// Asks for the first cache lines of a child that was pushed on the stack: by the time
 /// it is popped, after the nearer subtree, they have arrived (single rays and packets).
+/// Four lines, of a node's seven: asking for all seven measured no better.
 #[inline(always)]
 pub(super) unsafe fn prefetch(nodes: &[WideNode], packets: &[Packet], reference: u32) {
     #[cfg(target_arch = "x86_64")]

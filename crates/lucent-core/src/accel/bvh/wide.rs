@@ -10,9 +10,10 @@
 //! Why sixteen: a single ray's walk waits, at every node, on the chain from loading a
 //! child's reference to choosing the next child, so fewer levels are fewer waits; the
 //! second group of eight boxes is tested beside the first, off that chain. Against
-//! nodes of eight (on an AMD EPYC, Zen 4, paired): single rays 1.01–1.07× faster on
-//! the dragons, packets of rays the same, the same memory per triangle (see
-//! `docs/performance.md`). Leaves
+//! nodes of eight (on an AMD EPYC, Zen 4, paired): single rays 1.02–1.06× faster on
+//! the dragons with the AVX-512 build, about the same with AVX2 alone (0.96–1.01×),
+//! packets of rays the same, the same memory per triangle (see `docs/performance.md`).
+//! Leaves
 //! become runs of four-wide packets, laid out in the order traversal meets them. With
 //! more than one thread, large subtrees are laid out by tasks of their own, each as parts
 //! in the one-thread order, put together at the end; the packets are filled on the
