@@ -22,6 +22,7 @@ mod collapse_plan;
 mod lanes;
 mod packet;
 mod packet_frustum;
+mod packet_rays;
 mod ray_lanes;
 pub mod ray_packet;
 mod ray_triangle;
