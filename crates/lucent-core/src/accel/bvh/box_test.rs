@@ -1,17 +1,19 @@
-//! The box test of a BVH node visit: one ray against a node's sixteen child boxes, eight
-//! at a time with AVX when the CPU has it (detected at run time), else four at a time
-//! with SSE (the tests are written once over the lanes of [`super::lanes`]), giving which
-//! boxes it enters and at what distance.
+//! The box test of a BVH node visit: one ray against a node's sixteen child boxes, all
+//! sixteen at once with AVX-512 (any-hit queries), eight at a time with AVX when the CPU
+//! has it (detected at run time), else four at a time with SSE (the tests are written
+//! once over the lanes of [`super::lanes`]), giving which boxes it enters and at what
+//! distance.
 //!
 //! Every box test is conservative: it never rejects a box the exact slab test enters.
 //! * The SSE and scalar tests are the slab test of [`crate::aabb::Aabb::intersect`],
 //!   `(plane - origin) · (1/d)`, with the far distance widened by `1 + 2γ(3)` (folded
 //!   into a per-ray far reciprocal: the same roundings in another order).
-//! * With AVX2 and FMA, each plane costs one fused multiply–add, `plane · (1/d) − o/d`,
-//!   which is shorter on the path from loading a node to choosing the next one. Its
-//!   error is not relative to the result (`o/d` may dwarf the difference), so the ray
-//!   carries two offsets, `o/d ± c` with `c = 2⁻¹⁸·|o/d|`, and a far reciprocal widened
-//!   by `1 + 2⁻¹⁹`: [`FmaOffsets`] states the bound. Rays with an infinite constant, a
+//! * With AVX2 and FMA (and AVX-512), each plane costs one fused multiply–add,
+//!   `plane · (1/d) − o/d`, which is shorter on the path from loading a node to choosing
+//!   the next one. Its error is not relative to the result (`o/d` may dwarf the
+//!   difference), so the ray carries two offsets, `o/d ± c` with `c = 2⁻¹⁸·|o/d|`, and a
+//!   far reciprocal widened by `1 + 2⁻¹⁹`: [`FmaOffsets`] states the bound (the same
+//!   for every lane width). Rays with an infinite constant, a
 //!   negative `t_min` or an axis they do not move along take the plain AVX test.
 //!
 //! Axes along which the ray does not move are decided by where the origin lies (a
@@ -399,6 +401,16 @@ pub(super) mod tests {
                         check::<Slab<Avx>>("avx", &node, &r, &Slab::prepare(&rb, one), zero);
                         if let Some(offsets) = FmaOffsets::new(&pr) {
                             check::<Fused<Avx>>("avx+fma", &node, &r, &Fused::prepare(&rb, &offsets, one), false);
+                            if super::super::Isa::detect() == super::super::Isa::Avx512 {
+                                // The same operations sixteen lanes wide: the same bound.
+                                check::<Fused<super::super::lanes::Avx512>>(
+                                    "avx512+fma",
+                                    &node,
+                                    &r,
+                                    &Fused::prepare(&rb, &offsets, one),
+                                    false,
+                                );
+                            }
                             fused += 1;
                         }
                     }

@@ -1,8 +1,8 @@
 //! A few `f32` lanes side by side, and the handful of operations the box test needs,
-//! written once per instruction set: plain `f32` (one lane), SSE (four) and AVX (eight,
-//! with fused multiply–add). The box tests of [`super::traverse`] are written once over
-//! this trait, so a wider instruction set costs one implementation here, not another
-//! copy of the test.
+//! written once per instruction set: plain `f32` (one lane), SSE (four), AVX (eight,
+//! with fused multiply–add) and AVX-512 (sixteen, comparing into a mask register). The
+//! box tests of [`super::traverse`] are written once over this trait, so a wider
+//! instruction set costs one implementation here, not another copy of the test.
 //!
 //! Every operation is the single instruction it names (`max`/`min` return the second
 //! operand when either is NaN, as `maxps`/`minps` do); the implementations are
@@ -97,7 +97,7 @@ impl Lanes for f32 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx, Sse};
+pub use x86::{Avx, Avx512, Sse};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -178,6 +178,68 @@ mod x86 {
         #[inline(always)]
         unsafe fn mul_sub(self, b: Avx, c: Avx) -> Avx {
             Avx(_mm256_fmsub_ps(self.0, b.0, c.0))
+        }
+    }
+
+    /// Sixteen lanes (AVX-512 F): a whole node's boxes in one group, the comparisons into
+    /// a mask register. Not made with the macro above: the mask is a `__mmask16`, and
+    /// the bits are the mask itself.
+    #[derive(Clone, Copy)]
+    pub struct Avx512(__m512);
+
+    impl Lanes for Avx512 {
+        const N: usize = 16;
+        type Mask = __mmask16;
+        #[inline(always)]
+        unsafe fn splat(x: f32) -> Avx512 {
+            Avx512(_mm512_set1_ps(x))
+        }
+        #[inline(always)]
+        unsafe fn load(p: *const f32) -> Avx512 {
+            Avx512(_mm512_loadu_ps(p))
+        }
+        #[inline(always)]
+        unsafe fn store(self, p: *mut f32) {
+            _mm512_storeu_ps(p, self.0)
+        }
+        #[inline(always)]
+        unsafe fn sub(self, o: Avx512) -> Avx512 {
+            Avx512(_mm512_sub_ps(self.0, o.0))
+        }
+        #[inline(always)]
+        unsafe fn mul(self, o: Avx512) -> Avx512 {
+            Avx512(_mm512_mul_ps(self.0, o.0))
+        }
+        #[inline(always)]
+        unsafe fn max(self, o: Avx512) -> Avx512 {
+            Avx512(_mm512_max_ps(self.0, o.0))
+        }
+        #[inline(always)]
+        unsafe fn min(self, o: Avx512) -> Avx512 {
+            Avx512(_mm512_min_ps(self.0, o.0))
+        }
+        #[inline(always)]
+        unsafe fn le(self, o: Avx512) -> __mmask16 {
+            _mm512_cmp_ps_mask::<_CMP_LE_OQ>(self.0, o.0)
+        }
+        #[inline(always)]
+        unsafe fn and(a: __mmask16, b: __mmask16) -> __mmask16 {
+            a & b
+        }
+        #[inline(always)]
+        unsafe fn all() -> __mmask16 {
+            0xffff
+        }
+        #[inline(always)]
+        unsafe fn bits(m: __mmask16) -> u32 {
+            m as u32
+        }
+    }
+
+    impl FusedLanes for Avx512 {
+        #[inline(always)]
+        unsafe fn mul_sub(self, b: Avx512, c: Avx512) -> Avx512 {
+            Avx512(_mm512_fmsub_ps(self.0, b.0, c.0))
         }
     }
 }

@@ -41,8 +41,9 @@ use wide::WideNode;
 /// The instruction set the traversal uses on this CPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
-    /// AVX-512 F, VL and BW (with AVX2 and FMA): packets of sixteen rays; single rays
-    /// take the AVX2 code (eight boxes at a time) compiled for AVX-512 (see `run_avx512`).
+    /// AVX-512 F, VL and BW (with AVX2 and FMA): packets of sixteen rays; closest hits
+    /// take the AVX2 code (eight boxes at a time) compiled for AVX-512, any-hit queries
+    /// sixteen boxes at a time (see `run_avx512`).
     Avx512,
     /// AVX2 with FMA (every AVX2 CPU has both): packets of eight rays.
     Avx2,
@@ -225,6 +226,9 @@ impl Bvh {
 trait Query<P: PrimitiveSet + ?Sized> {
     type Answer;
     const NONE: Self::Answer;
+    /// Whether the query visits children nearest first (and so needs their entry
+    /// distances): closest hits do, any-hit queries do not.
+    const ORDERED: bool;
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
     /// direction component, and the tree at most `STACK / (WIDTH - 1)` levels deep.
@@ -242,6 +246,7 @@ struct Occluded;
 impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
     type Answer = Option<Hit>;
     const NONE: Option<Hit> = None;
+    const ORDERED: bool = true;
     #[inline(always)]
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
         b: &Bvh,
@@ -256,6 +261,7 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
 impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
     type Answer = bool;
     const NONE: bool = false;
+    const ORDERED: bool = false;
     #[inline(always)]
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
         b: &Bvh,
@@ -277,20 +283,35 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
     run_fused::<Q, P>(b, prims, r)
 }
 
-/// The same code as [`run_avx2`] (the same 8-lane operations, the same answers), compiled
-/// with AVX-512 VL: 32 vector registers, so the ray's constants stay in registers, and
-/// comparisons into mask registers. Measured on an AMD EPYC (Zen 4): closest hits
-/// 1.05–1.11× faster than the AVX2 build; any-hit queries were not (0.93–1.01×) until the
-/// lanes the SIMD leaf test leaves over went out of line, and are since (1.065–1.089× on
-/// the dragons' shadow rays), so both queries take it.
+/// The AVX-512 paths. Closest hits run the same code as [`run_avx2`] (the same 8-lane
+/// operations, two groups per node), compiled with AVX-512 VL: 32 vector registers, so
+/// the ray's constants stay in registers, and comparisons into mask registers (measured
+/// on an AMD EPYC, Zen 4: 1.05–1.11× faster than the AVX2 build). Any-hit queries test
+/// a node's sixteen boxes as one 16-lane group ([`lanes::Avx512`]): 1.037× on both
+/// dragons' shadow rays on that CPU. Closest hits lost 7 % that way there (0.927; 0.975
+/// with the distances stored as two halves): they read the entry distances back from
+/// memory to order the children, and Zen 4 forwards a 512-bit store to those loads
+/// slowly; any-hit queries need no distances.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
-    run_fused::<Q, P>(b, prims, r)
+    use box_test::Fused;
+    if Q::ORDERED {
+        return run_fused::<Q, P>(b, prims, r);
+    }
+    match FmaOffsets::new(r) {
+        Some(offsets) => Q::run::<Fused<lanes::Avx512>, false, SHALLOW_STACK>(
+            b,
+            prims,
+            r,
+            &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
+        ),
+        None => run_avx2_plain::<Q, P>(b, prims, r),
+    }
 }
 
-/// The body of [`run_avx2`] and [`run_avx512`], compiled into each with its caller's
-/// instruction set.
+/// The body of [`run_avx2`] and of [`run_avx512`]'s closest hits, compiled into each
+/// with its caller's instruction set.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
