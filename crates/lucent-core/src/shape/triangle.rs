@@ -87,8 +87,9 @@ pub fn intersect(r: &PreparedRay, p0: Vec3A, p1: Vec3A, p2: Vec3A, t_max: f32) -
 /// at 10⁻³ to 1 of sine to the plane) found theirs only on triangles this rule checks
 /// (test `rays_leaving_a_triangle_never_find_it_again`). Checking every hit cost the
 /// BVH's SIMD tests 5 % on camera rays of a fine mesh, where it never changes an answer;
-/// instead the BVH leaves the triangles this rule picks to this scalar test (see
-/// `accel::bvh::packet`), so every structure gives the same answers as the list.
+/// instead the BVH hands the hits its SIMD tests accept on the triangles this rule picks
+/// to this scalar test (see `accel::bvh::packet`), so every structure gives the same
+/// answers as the list.
 pub const T_CHECK_RATIO: f32 = 4.0;
 
 /// Whether hits on this triangle are checked against [`t_error_bound`] (see
@@ -104,7 +105,7 @@ pub fn checks_t_error(p0: Vec3A, p1: Vec3A, p2: Vec3A) -> bool {
 /// triangle's `δt`), from the sheared corners `x`, `y`, `z` (z already scaled by `sz`),
 /// the edge functions `e` and `1/det`. A computed `t` at or below it may be a hit behind
 /// the origin. Applied to the triangles [`checks_t_error`] picks, by this scalar test
-/// only: the BVH's SIMD tests hand those triangles to it.
+/// only: the BVH's SIMD tests hand those triangles' hits to it.
 #[inline(always)]
 pub fn t_error_bound(x: [f32; 3], y: [f32; 3], z: [f32; 3], e: [f32; 3], inv_det: f32) -> f32 {
     let max_abs = |a: [f32; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());

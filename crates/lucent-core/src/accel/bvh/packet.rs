@@ -8,9 +8,12 @@
 //! zero take the scalar path (and its f64 fallback). Non-triangle primitives (spheres)
 //! sit in a packet as a flagged index with NaN corners and are tested by the scalar
 //! primitive code; unused lanes hold NaN corners, which no test accepts. Large
-//! triangles ([`triangle::checks_t_error`]) are flagged and tested the same way as
-//! non-triangles: the scalar test checks their hits against the bound on the error of
-//! `t`, which the SIMD test leaves out (on a fine mesh it would never change an answer).
+//! triangles ([`triangle::checks_t_error`]) are flagged too but keep their corners: the
+//! SIMD test computes their `t` as for any triangle, and only a hit it accepts goes to
+//! the scalar test, which checks it against the bound on the error of `t` (the SIMD test
+//! leaves that bound out: on a fine mesh it would never change an answer). A miss there
+//! is a miss of the scalar test too, which accepts only what the SIMD test accepts and
+//! passes the bound.
 
 use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
@@ -18,8 +21,8 @@ use crate::ray::PreparedRay;
 use crate::shape::triangle;
 
 pub const LANES: usize = 4;
-/// Marks a lane whose primitive is not a triangle, or a triangle that
-/// [`triangle::checks_t_error`].
+/// Marks a lane whose primitive is not a triangle (its corners are NaN), or a triangle
+/// that [`triangle::checks_t_error`] (its corners are stored).
 const OTHER: u32 = 1 << 31;
 /// An unused lane (no high bit, so it is skipped by the `OTHER` check for free).
 const UNUSED: u32 = OTHER - 1;
@@ -30,7 +33,8 @@ const UNUSED: u32 = OTHER - 1;
 pub struct Packet {
     /// `p[corner][axis][lane]`.
     p: [[[f32; LANES]; 3]; 3],
-    /// Primitive index per lane; `OTHER` set for non-triangles, `UNUSED` for empty lanes.
+    /// Primitive index per lane; `OTHER` set for non-triangles and checked triangles,
+    /// `UNUSED` for empty lanes.
     ids: [u32; LANES],
 }
 
@@ -44,17 +48,18 @@ impl Packet {
         };
         for (lane, &id) in ids.iter().enumerate() {
             match prims.triangle(id) {
-                // A triangle whose hits are checked against the bound on the error of `t`
-                // goes to its primitive's own (scalar) test, which makes that check.
-                Some(p) if !triangle::checks_t_error(p[0], p[1], p[2]) => {
+                Some(p) => {
                     for (corner, v) in p.iter().enumerate() {
                         for axis in 0..3 {
                             pk.p[corner][axis][lane] = v[axis];
                         }
                     }
-                    pk.ids[lane] = id;
+                    // A triangle whose hits are checked against the bound on the error of
+                    // `t`: the scalar test decides the hits the SIMD test accepts.
+                    let checked = triangle::checks_t_error(p[0], p[1], p[2]);
+                    pk.ids[lane] = if checked { id | OTHER } else { id };
                 }
-                _ => pk.ids[lane] = id | OTHER,
+                None => pk.ids[lane] = id | OTHER,
             }
         }
         pk
@@ -65,8 +70,11 @@ impl Packet {
     pub fn lane_kind(&self, lane: usize) -> LaneKind {
         match self.ids[lane] {
             UNUSED => LaneKind::Unused,
-            id if id & OTHER != 0 => LaneKind::Other(id & !OTHER),
-            id => LaneKind::Triangle(id),
+            id if id & OTHER != 0 && self.p[0][0][lane].is_nan() => LaneKind::Other(id & !OTHER),
+            id => LaneKind::Triangle {
+                id: id & !OTHER,
+                checked: id & OTHER != 0,
+            },
         }
     }
 
@@ -105,8 +113,8 @@ impl Packet {
         }
     }
 
-    /// The lanes the SIMD test leaves to scalar code: other primitives, large triangles
-    /// and edge cases. Out of line: inlined, this rarely run code took registers from the
+    /// The lanes the SIMD test leaves to scalar code: other primitives, large triangles'
+    /// hits and edge cases. Out of line: inlined, this rarely run code took registers from the
     /// traversal loop around it; out of line, the loop ran 3–6 % faster on fine meshes.
     #[cold]
     #[inline(never)]
@@ -119,12 +127,12 @@ impl Packet {
         best: &mut Option<Hit>,
     ) {
         for lane in Lanes(scalar) {
-            let id = self.ids[lane];
-            let hit = if id & OTHER != 0 {
-                prims.intersect(id & !OTHER, r, *t_max)
-            } else {
-                self.scalar_triangle(r, lane, *t_max)
-                    .map(|(t, b1, b2)| Hit::new(t, id, b1, b2))
+            let hit = match self.lane_kind(lane) {
+                LaneKind::Other(id) => prims.intersect(id, r, *t_max),
+                LaneKind::Triangle { id, .. } => self
+                    .scalar_triangle(r, lane, *t_max)
+                    .map(|(t, b1, b2)| Hit::new(t, id, b1, b2)),
+                LaneKind::Unused => None,
             };
             if let Some(hit) = hit {
                 Self::record(prims, hit, t_max, best);
@@ -146,13 +154,10 @@ impl Packet {
     #[cold]
     #[inline(never)]
     fn any_hit_scalar<P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, scalar: u32, t_max: f32) -> bool {
-        Lanes(scalar).any(|lane| {
-            let id = self.ids[lane];
-            if id & OTHER != 0 {
-                prims.occludes(id & !OTHER, r, t_max)
-            } else {
-                self.scalar_triangle(r, lane, t_max).is_some()
-            }
+        Lanes(scalar).any(|lane| match self.lane_kind(lane) {
+            LaneKind::Other(id) => prims.occludes(id, r, t_max),
+            LaneKind::Triangle { .. } => self.scalar_triangle(r, lane, t_max).is_some(),
+            LaneKind::Unused => false,
         })
     }
 
@@ -217,15 +222,13 @@ impl Packet {
             _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
             _mm_cmpeq_ps(w, zero),
         );
-        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
-        // Lanes the scalar code takes: edge functions that rounded to zero, and
-        // non-triangles (flagged; their NaN corners never pass the tests below).
-        let scalar = _mm_movemask_ps(any_zero) as u32 | other;
+        // Lanes whose edge functions rounded to zero: the scalar code decides them.
+        let any_zero = _mm_movemask_ps(any_zero) as u32;
         // With no zero among them, the three edge functions agree in sign exactly when
-        // the sign bits of `u ^ v` and `u ^ w` are clear. (Unused lanes hold NaN, whose
-        // sign is arbitrary; their distance is NaN and fails the range test.)
+        // the sign bits of `u ^ v` and `u ^ w` are clear. (Unused lanes and non-triangles
+        // hold NaN, whose sign is arbitrary; their distance is NaN and fails the range test.)
         let mixed = _mm_movemask_ps(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w))) as u32;
-        let inside = !mixed & !scalar & 0xF;
+        let inside = !mixed & !any_zero & 0xF;
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let t_scaled = _mm_add_ps(
             _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, az)), _mm_mul_ps(v, _mm_mul_ps(sz, bz))),
@@ -240,7 +243,17 @@ impl Packet {
                 _mm_cmple_ps(t, _mm_set1_ps(t_max)),
             ),
         );
-        let mask = _mm_movemask_ps(accept) as u32 & inside;
+        let accepted = _mm_movemask_ps(accept) as u32 & inside;
+        // Flagged lanes: non-triangles (NaN corners, so NaN edge functions) always go to the
+        // scalar code, checked triangles only with a hit the SIMD test accepted.
+        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
+        let scalar = if other == 0 {
+            any_zero
+        } else {
+            let nan = _mm_movemask_ps(_mm_cmpunord_ps(det, det)) as u32;
+            any_zero | other & (nan | accepted)
+        };
+        let mask = accepted & !other;
         let mut hits = LaneHits::none(scalar);
         hits.mask = mask;
         if mask != 0 {
@@ -269,9 +282,13 @@ impl Packet {
 /// The primitive a packet lane holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LaneKind {
-    Triangle(u32),
-    /// A primitive that is not a triangle, or a large triangle: tested by the primitive's
-    /// own code.
+    /// A triangle; `checked`: its hits must also pass the bound on the error of `t`
+    /// ([`triangle::checks_t_error`]), which the scalar test applies.
+    Triangle {
+        id: u32,
+        checked: bool,
+    },
+    /// A primitive that is not a triangle: tested by the primitive's own code.
     Other(u32),
     Unused,
 }

@@ -423,9 +423,15 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                     }
                     (active, 0, *t_max_lanes)
                 }
-                LaneKind::Triangle(id) => {
+                LaneKind::Triangle { id, checked } => {
                     let h = ray_triangle::test(packet, lane, sh, *t_max_lanes, active);
-                    let (accept, scalar) = (h.accept, h.scalar);
+                    // A checked triangle's hits go to the scalar test, which applies the
+                    // bound on the error of `t`; its misses are the scalar test's too.
+                    let (accept, scalar) = if checked {
+                        (0, h.accept | h.scalar)
+                    } else {
+                        (h.accept, h.scalar)
+                    };
                     if accept != 0 {
                         if Q::SHRINKS {
                             // A closest hit will be shaded: its data on the way (see
