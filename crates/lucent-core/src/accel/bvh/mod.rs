@@ -288,10 +288,11 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
 /// the ray's constants stay in registers, and comparisons into mask registers (measured
 /// on an AMD EPYC, Zen 4: 1.05–1.11× faster than the AVX2 build). Any-hit queries test
 /// a node's sixteen boxes as one 16-lane group ([`lanes::Avx512`]): 1.037× on both
-/// dragons' shadow rays on that CPU. Closest hits lost 7 % that way there (0.927; 0.975
-/// with the distances stored as two halves): they read the entry distances back from
-/// memory to order the children, and Zen 4 forwards a 512-bit store to those loads
-/// slowly; any-hit queries need no distances.
+/// dragons' shadow rays on that CPU. Closest hits lost 7 % that way there (0.927): they
+/// read the children's entry distances back from memory to order them, and storing the
+/// distances as two 256-bit halves brought that to 0.975, so part of the loss is Zen 4
+/// forwarding a 512-bit store to the loads that follow; any-hit queries need no
+/// distances. (On a CPU with full-width AVX-512 this is still to be measured.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
