@@ -114,8 +114,8 @@ impl Packet {
     }
 
     /// The lanes the SIMD test leaves to scalar code: other primitives, large triangles'
-    /// hits and edge cases. Out of line: inlined, this rarely run code took registers from the
-    /// traversal loop around it; out of line, the loop ran 3–6 % faster on fine meshes.
+    /// hits and edge cases. Out of line: inlined, this rarely run code took registers from
+    /// the traversal loop around it; out of line, the loop ran 3–6 % faster on fine meshes.
     #[cold]
     #[inline(never)]
     fn closest_scalar<P: PrimitiveSet + ?Sized>(

@@ -19,9 +19,10 @@
 //! whole packet shares them, else both are computed and the `min`/`max` taken (the
 //! bound holds for both). So every ray visits at least the boxes that hold its closest
 //! hit, against its own closest hit so far and search limit. Both leaf tests compute the
-//! scalar triangle test's bits, accept `t ≤ t_max` and keep ties by primitive index, so
-//! neither the order of visits nor the order of triangles within a leaf can change a
-//! ray's answer. The interval test never drops a box the exact slab test has some ray
+//! scalar triangle test's bits (a large triangle's accepted hits then go to the scalar
+//! test itself, for its bound on the error of `t`), accept `t ≤ t_max` and keep ties by
+//! primitive index, so neither the order of visits nor the order of triangles within a
+//! leaf can change a ray's answer. The interval test never drops a box the exact slab test has some ray
 //! enter, and its near bound (an inner node's key and entry distance) is at most every
 //! ray's, so it keeps the same guarantee. Rays without the fused test's constants (an
 //! axis they do not move along, a constant that is not finite, a negative `t_min`) are
