@@ -237,9 +237,28 @@ pub fn render_after(
 
 /// The sums of the samples of one tile's pixels and how many each took; `None` as soon
 /// as `cancel` is set (it is looked at between pixels and every [`CANCEL_EVERY`] samples).
-/// Camera samples made ahead and finished together: up to this many, in the tile's
-/// order, have their camera rays traced at once (in packets, [`Scene::closest_hits`]).
+/// Camera samples made ahead and finished together: up to this many, in the order the
+/// tile's pixels are visited ([`block_order`]), have their camera rays traced at once (in
+/// packets, [`Scene::closest_hits`]).
 const CAMERA_BATCH: usize = 64;
+
+/// The side of the square blocks a tile's pixels are visited in (see [`block_order`]).
+const BLOCK: u32 = 4;
+
+/// The pixels of `tile` block by block: blocks of [`BLOCK`] × [`BLOCK`] pixels in reading
+/// order, and each block's pixels in reading order. A packet of camera rays (16 with
+/// AVX-512, 8 with AVX2) then covers a square of pixels at one sample per pixel, not a
+/// strip of a row: fewer boxes and leaves for the packet (scene7's render phase 1.045×
+/// [1.031–1.111], 20 paired rounds, AMD EPYC). Each pixel's samples are the same
+/// whatever the order (its sampler depends on the pixel and the sample index only), and
+/// a pixel's sums do not depend on when its samples are added.
+fn block_order(tile: &Tile) -> impl Iterator<Item = (u32, u32)> + '_ {
+    (tile.y0..tile.y1).step_by(BLOCK as usize).flat_map(move |by| {
+        (tile.x0..tile.x1).step_by(BLOCK as usize).flat_map(move |bx| {
+            (by..(by + BLOCK).min(tile.y1)).flat_map(move |y| (bx..(bx + BLOCK).min(tile.x1)).map(move |x| (x, y)))
+        })
+    })
+}
 
 /// A camera sample made, waiting for its ray's closest hit (its ray and its sampler,
 /// past the numbers the camera drew, wait beside it).
@@ -301,7 +320,7 @@ fn render_tile(
             }
         }
     }
-    // Samples are made in the tile's order, pixel by pixel, and finished in the same
+    // Samples are made pixel by pixel (in `block_order`), and finished in the same
     // order, so every pixel's sums and stopping point are what one sample at a time
     // gives. Adaptive sampling decides after each sample whether its pixel takes the
     // next: one at a time there.
@@ -353,62 +372,59 @@ fn render_tile(
         }
         samplers.clear();
     };
-    let mut pixel = 0;
-    for y in tile.y0..tile.y1 {
-        for x in tile.x0..tile.x1 {
-            if shuffle_lens {
-                lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
+    for (x, y) in block_order(tile) {
+        let pixel = ((y - tile.y0) * (tile.x1 - tile.x0) + (x - tile.x0)) as usize;
+        if shuffle_lens {
+            lens_strata = shuffled_strata(job.seed, x, y, n, lens_strata);
+        }
+        for i in job.samples.clone() {
+            if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
+                return None;
             }
-            for i in job.samples.clone() {
-                if (i - job.samples.start) % CANCEL_EVERY == 0 && cancel.load(Ordering::Relaxed) {
-                    return None;
-                }
-                if pixels.noise.get(pixel).is_some_and(|p| p.stopped) {
-                    break;
-                }
-                let mut sampler = Sampler::start(job.sampler, job.seed, x, y, i);
-                let (dx, dy) = match sampling {
-                    // One sample goes through the pixel centre; more are jittered over
-                    // the pixel (one per cell of a √n × √n grid when n is a square).
-                    PixelSampling::Stratified if n == 1 => (0.5, 0.5),
-                    PixelSampling::Stratified => {
-                        let (u, v) = sampler.uniform2();
-                        stratified(i, n, u, v)
-                    }
-                    // A single sample through the centre, more anywhere in the pixel; the
-                    // two numbers are drawn either way, so that the integrator's numbers
-                    // are the same dimensions for every sample.
-                    PixelSampling::Uniform => {
-                        let (u, v) = sampler.uniform2();
-                        if n == 1 {
-                            (0.5, 0.5)
-                        } else {
-                            (u, v)
-                        }
-                    }
-                };
-                let lens = if shuffle_lens {
-                    // The lens strata in another order than the pixel's, so that where a
-                    // sample falls in the pixel says nothing about where it leaves the lens.
+            if pixels.noise.get(pixel).is_some_and(|p| p.stopped) {
+                break;
+            }
+            let mut sampler = Sampler::start(job.sampler, job.seed, x, y, i);
+            let (dx, dy) = match sampling {
+                // One sample goes through the pixel centre; more are jittered over
+                // the pixel (one per cell of a √n × √n grid when n is a square).
+                PixelSampling::Stratified if n == 1 => (0.5, 0.5),
+                PixelSampling::Stratified => {
                     let (u, v) = sampler.uniform2();
-                    stratified(lens_strata[i as usize], n, u, v)
-                } else if scene.camera.has_lens() {
-                    sampler.uniform2()
-                } else {
-                    (0.5, 0.5)
-                };
-                rays.push(
-                    scene
-                        .camera
-                        .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens),
-                );
-                made.push(CameraSample { pixel, x, y });
-                samplers.push(sampler);
-                if made.len() == batch {
-                    finish(&mut made, &mut rays, &mut samplers, &mut pixels);
+                    stratified(i, n, u, v)
                 }
+                // A single sample through the centre, more anywhere in the pixel; the
+                // two numbers are drawn either way, so that the integrator's numbers
+                // are the same dimensions for every sample.
+                PixelSampling::Uniform => {
+                    let (u, v) = sampler.uniform2();
+                    if n == 1 {
+                        (0.5, 0.5)
+                    } else {
+                        (u, v)
+                    }
+                }
+            };
+            let lens = if shuffle_lens {
+                // The lens strata in another order than the pixel's, so that where a
+                // sample falls in the pixel says nothing about where it leaves the lens.
+                let (u, v) = sampler.uniform2();
+                stratified(lens_strata[i as usize], n, u, v)
+            } else if scene.camera.has_lens() {
+                sampler.uniform2()
+            } else {
+                (0.5, 0.5)
+            };
+            rays.push(
+                scene
+                    .camera
+                    .ray(job.resolution, x as f64 + dx as f64, y as f64 + dy as f64, lens),
+            );
+            made.push(CameraSample { pixel, x, y });
+            samplers.push(sampler);
+            if made.len() == batch {
+                finish(&mut made, &mut rays, &mut samplers, &mut pixels);
             }
-            pixel += 1;
         }
     }
     finish(&mut made, &mut rays, &mut samplers, &mut pixels);
@@ -445,6 +461,38 @@ fn shuffled_strata(seed: u64, x: u32, y: u32, n: u32, mut out: Vec<u32>) -> Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn block_order_visits_every_pixel_of_a_tile_once_in_square_blocks() {
+        // A whole tile, and tiles cut by the image's edge or a crop (sides not multiples of 4).
+        for (x0, y0, x1, y1) in [(0, 0, 16, 16), (32, 16, 45, 23), (5, 3, 6, 4), (0, 0, 3, 9)] {
+            let tile = Tile { x0, y0, x1, y1 };
+            let order: Vec<(u32, u32)> = block_order(&tile).collect();
+            let mut sorted = order.clone();
+            sorted.sort_unstable_by_key(|&(x, y)| (y, x));
+            sorted.dedup();
+            let all: Vec<(u32, u32)> = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).collect();
+            assert_eq!(sorted, all, "{x0} {y0} {x1} {y1}");
+            assert_eq!(order.len(), all.len());
+        }
+        // In a whole tile every run of 16 pixels is a 4 × 4 square.
+        let tile = Tile {
+            x0: 0,
+            y0: 0,
+            x1: 16,
+            y1: 16,
+        };
+        let order: Vec<(u32, u32)> = block_order(&tile).collect();
+        for run in order.chunks(16) {
+            let (x, y) = run[0];
+            assert_eq!(
+                run,
+                (y..y + 4)
+                    .flat_map(|y| (x..x + 4).map(move |x| (x, y)))
+                    .collect::<Vec<_>>()
+            );
+        }
+    }
 
     #[test]
     fn lens_strata_are_a_permutation_fixed_by_the_pixel() {
