@@ -91,7 +91,7 @@ path, name, bytes_per_tri = sys.argv[1:4]
 rows = [tuple(map(float, l.split())) for l in open(path) if l.strip()]
 ratios = sorted(a / b for a, b in rows)
 n = len(ratios)
-print(f"## Build threads ({name}, `bench rays --build-threads`, best of 3 builds per run)\n")
+print(f"## Build threads ({name}, `bench rays --build-threads`, median of 3 builds per run)\n")
 print(f"- 1 thread: median {statistics.median(r[0] for r in rows):.3f} s; "
       f"2 threads: median {statistics.median(r[1] for r in rows):.3f} s")
 print(f"- 2 threads over 1, median of {n} paired ratios: **{statistics.median(ratios):.2f}×** "
