@@ -235,8 +235,6 @@ pub fn render_after(
     Some((film, stats))
 }
 
-/// The sums of the samples of one tile's pixels and how many each took; `None` as soon
-/// as `cancel` is set (it is looked at between pixels and every [`CANCEL_EVERY`] samples).
 /// Camera samples made ahead and finished together: up to this many, in the order the
 /// tile's pixels are visited ([`block_order`]), have their camera rays traced at once (in
 /// packets, [`Scene::closest_hits`]).
@@ -269,6 +267,8 @@ struct CameraSample {
     y: u32,
 }
 
+/// The sums of the samples of one tile's pixels and how many each took; `None` as soon
+/// as `cancel` is set (it is looked at between pixels and every [`CANCEL_EVERY`] samples).
 fn render_tile(
     scene: &Scene,
     integrator: &dyn Integrator,
