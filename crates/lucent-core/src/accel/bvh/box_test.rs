@@ -13,8 +13,8 @@
 //!   the next one. Its error is not relative to the result (`o/d` may dwarf the
 //!   difference), so the ray carries two offsets, `o/d ± c` with `c = 2⁻¹⁸·|o/d|`, and a
 //!   far reciprocal widened by `1 + 2⁻¹⁹`: [`FmaOffsets`] states the bound (the same
-//!   for every lane width). Rays with an infinite constant, a
-//!   negative `t_min` or an axis they do not move along take the plain AVX test.
+//!   for every lane width). Rays with an infinite constant, a negative `t_min` or an
+//!   axis they do not move along take the plain AVX test.
 //!
 //! Axes along which the ray does not move are decided by where the origin lies (a
 //! separate instantiation, since such rays are rare).

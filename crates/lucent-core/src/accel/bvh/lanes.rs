@@ -104,10 +104,11 @@ mod x86 {
     use super::{FusedLanes, Lanes};
     use std::arch::x86_64::*;
 
-    /// A [`Lanes`] type over an x86 vector, from the intrinsic of each operation.
+    /// A [`Lanes`] type over an x86 vector, from the intrinsic of each operation; `$mask`
+    /// is what a comparison gives (a vector of lane masks, or an AVX-512 mask register).
     macro_rules! x86_lanes {
         (
-            $(#[$doc:meta])* $name:ident($vector:ty, $n:literal):
+            $(#[$doc:meta])* $name:ident($vector:ty, $mask:ty, $n:literal):
             splat $splat:expr, load $load:expr, store $store:expr,
             [$($op:ident $op_fn:expr),+],
             le $le:expr, and $and:expr, all $all:expr, bits $bits:expr
@@ -118,7 +119,7 @@ mod x86 {
 
             impl Lanes for $name {
                 const N: usize = $n;
-                type Mask = $vector;
+                type Mask = $mask;
                 #[inline(always)]
                 unsafe fn splat(x: f32) -> $name {
                     $name($splat(x))
@@ -138,19 +139,19 @@ mod x86 {
                     }
                 )+
                 #[inline(always)]
-                unsafe fn le(self, other: $name) -> $vector {
+                unsafe fn le(self, other: $name) -> $mask {
                     $le(self.0, other.0)
                 }
                 #[inline(always)]
-                unsafe fn and(a: $vector, b: $vector) -> $vector {
+                unsafe fn and(a: $mask, b: $mask) -> $mask {
                     $and(a, b)
                 }
                 #[inline(always)]
-                unsafe fn all() -> $vector {
+                unsafe fn all() -> $mask {
                     $all
                 }
                 #[inline(always)]
-                unsafe fn bits(m: $vector) -> u32 {
+                unsafe fn bits(m: $mask) -> u32 {
                     $bits(m) as u32
                 }
             }
@@ -159,7 +160,7 @@ mod x86 {
 
     x86_lanes! {
         /// Four lanes (SSE, part of every x86-64).
-        Sse(__m128, 4):
+        Sse(__m128, __m128, 4):
         splat _mm_set1_ps, load _mm_load_ps, store _mm_storeu_ps,
         [sub _mm_sub_ps, mul _mm_mul_ps, max _mm_max_ps, min _mm_min_ps],
         le _mm_cmple_ps, and _mm_and_ps, all _mm_castsi128_ps(_mm_set1_epi32(-1)), bits _mm_movemask_ps
@@ -167,7 +168,7 @@ mod x86 {
 
     x86_lanes! {
         /// Eight lanes (AVX; the fused form needs FMA, which every AVX2 CPU has).
-        Avx(__m256, 8):
+        Avx(__m256, __m256, 8):
         splat _mm256_set1_ps, load _mm256_load_ps, store _mm256_storeu_ps,
         [sub _mm256_sub_ps, mul _mm256_mul_ps, max _mm256_max_ps, min _mm256_min_ps],
         le _mm256_cmp_ps::<_CMP_LE_OQ>, and _mm256_and_ps,
@@ -181,59 +182,14 @@ mod x86 {
         }
     }
 
-    /// Sixteen lanes (AVX-512 F): a whole node's boxes in one group, the comparisons into
-    /// a mask register. Not made with the macro above: the mask is a `__mmask16`, and
-    /// the bits are the mask itself.
-    #[derive(Clone, Copy)]
-    pub struct Avx512(__m512);
-
-    impl Lanes for Avx512 {
-        const N: usize = 16;
-        type Mask = __mmask16;
-        #[inline(always)]
-        unsafe fn splat(x: f32) -> Avx512 {
-            Avx512(_mm512_set1_ps(x))
-        }
-        #[inline(always)]
-        unsafe fn load(p: *const f32) -> Avx512 {
-            Avx512(_mm512_loadu_ps(p))
-        }
-        #[inline(always)]
-        unsafe fn store(self, p: *mut f32) {
-            _mm512_storeu_ps(p, self.0)
-        }
-        #[inline(always)]
-        unsafe fn sub(self, o: Avx512) -> Avx512 {
-            Avx512(_mm512_sub_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn mul(self, o: Avx512) -> Avx512 {
-            Avx512(_mm512_mul_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn max(self, o: Avx512) -> Avx512 {
-            Avx512(_mm512_max_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn min(self, o: Avx512) -> Avx512 {
-            Avx512(_mm512_min_ps(self.0, o.0))
-        }
-        #[inline(always)]
-        unsafe fn le(self, o: Avx512) -> __mmask16 {
-            _mm512_cmp_ps_mask::<_CMP_LE_OQ>(self.0, o.0)
-        }
-        #[inline(always)]
-        unsafe fn and(a: __mmask16, b: __mmask16) -> __mmask16 {
-            a & b
-        }
-        #[inline(always)]
-        unsafe fn all() -> __mmask16 {
-            0xffff
-        }
-        #[inline(always)]
-        unsafe fn bits(m: __mmask16) -> u32 {
-            m as u32
-        }
+    x86_lanes! {
+        /// Sixteen lanes (AVX-512 F): a whole node's boxes in one group, the comparisons
+        /// into a mask register, whose bits are the lanes'.
+        Avx512(__m512, __mmask16, 16):
+        splat _mm512_set1_ps, load _mm512_loadu_ps, store _mm512_storeu_ps,
+        [sub _mm512_sub_ps, mul _mm512_mul_ps, max _mm512_max_ps, min _mm512_min_ps],
+        le _mm512_cmp_ps_mask::<_CMP_LE_OQ>, and (|a: __mmask16, b: __mmask16| a & b), all 0xffff,
+        bits std::convert::identity
     }
 
     impl FusedLanes for Avx512 {

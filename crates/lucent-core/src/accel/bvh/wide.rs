@@ -5,7 +5,7 @@
 //! eight primitives, one or two packets) or a wide node of its own. Which cut, and which
 //! subtrees become leaves, is the plan of [`super::collapse_plan`]: the least expected
 //! cost by the surface area heuristic. The node stores its children's boxes as
-//! structure-of-arrays, so two AVX instructions (or four SSE ones) test all sixteen.
+//! structure-of-arrays, so two AVX instructions (one AVX-512, four SSE) test all sixteen.
 //!
 //! Why sixteen: a single ray's walk waits, at every node, on the chain from loading a
 //! child's reference to choosing the next child, so fewer levels are fewer waits; the
@@ -13,10 +13,10 @@
 //! nodes of eight (on an AMD EPYC, Zen 4, paired): single rays 1.02–1.06× faster on
 //! the dragons with the AVX-512 build, about the same with AVX2 alone (0.96–1.01×),
 //! packets of rays the same, the same memory per triangle (see `docs/performance.md`).
-//! Leaves
-//! become runs of four-wide packets, laid out in the order traversal meets them. With
-//! more than one thread, large subtrees are laid out by tasks of their own, each as parts
-//! in the one-thread order, put together at the end; the packets are filled on the
+//!
+//! Leaves become runs of four-wide packets, laid out in the order traversal meets them.
+//! With more than one thread, large subtrees are laid out by tasks of their own, each as
+//! parts in the one-thread order, put together at the end; the packets are filled on the
 //! pool's threads: the same tree for any number of threads.
 
 use super::binary::{BinaryNode, BinaryTree, Kind, MAX_LEAF};
