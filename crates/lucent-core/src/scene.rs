@@ -157,6 +157,14 @@ impl Scene {
         self.geometry.closest_hit_prepared(ray)
     }
 
+    /// [`Scene::closest_hit_prepared`] into `best`, where the caller keeps it: a hit
+    /// copied out of the structure's search would be read back whole just after it was
+    /// written piece by piece (a stalled store-to-load forward per ray).
+    #[inline]
+    pub fn closest_hit_into(&self, ray: &PreparedRay, best: &mut Option<Hit>) {
+        self.geometry.closest_hit_into(ray, best)
+    }
+
     /// [`Scene::occluded`] of a ray prepared already.
     #[inline]
     pub fn occluded_prepared(&self, ray: &PreparedRay) -> bool {

@@ -99,6 +99,11 @@ pub fn is_bounded(b: &Aabb) -> bool {
 pub trait Accelerator<P: PrimitiveSet + ?Sized>: Send + Sync {
     /// The closest hit with `ray.t_min < t <= ray.t_max`.
     fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit>;
+    /// [`Accelerator::closest_hit`] into `out`: the same answer, written where the caller
+    /// keeps it (the BVH searches in it, and so spares a copy of the hit).
+    fn closest_hit_into(&self, prims: &P, r: &PreparedRay, out: &mut Option<Hit>) {
+        *out = self.closest_hit(prims, r);
+    }
     /// Whether anything lies in `(ray.t_min, ray.t_max]` (shadow rays).
     fn occluded(&self, prims: &P, r: &PreparedRay) -> bool;
     /// Bytes used by the structure itself (not counting the primitives).

@@ -37,13 +37,21 @@ impl Geometry {
     /// [`Geometry::closest_hit`] of a ray prepared already.
     #[inline]
     pub fn closest_hit_prepared(&self, r: &PreparedRay) -> Option<Hit> {
-        let mut best = self.accel.closest_hit(&self.primitives, r);
+        let mut best = None;
+        self.closest_hit_into(r, &mut best);
+        best
+    }
+
+    /// [`Geometry::closest_hit_prepared`] into `best`, where the caller keeps it (see
+    /// [`crate::accel::Accelerator::closest_hit_into`]).
+    #[inline]
+    pub fn closest_hit_into(&self, r: &PreparedRay, best: &mut Option<Hit>) {
+        self.accel.closest_hit_into(&self.primitives, r, best);
         // (The emptiness test here: the search is not inlined, and most scenes have no
         // planes.)
         if !self.unbounded.is_empty() {
-            self.nearer_unbounded(r, &mut best);
+            self.nearer_unbounded(r, best);
         }
-        best
     }
 
     /// [`Geometry::closest_hit`] of each of `rays` (`out[i]` for `rays[i]`), coherent

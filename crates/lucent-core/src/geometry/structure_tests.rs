@@ -7,6 +7,7 @@ use super::test_scenes::{analytic_soup, coplanar_grid, soup, Rng};
 use crate::accel::bvh::{Bvh, Isa};
 use crate::accel::list::PrimitiveList;
 use crate::accel::{AccelKind, Accelerator};
+use crate::hit::Hit;
 use crate::math::Vec3A;
 use crate::ray::{PreparedRay, Ray};
 
@@ -43,6 +44,10 @@ fn check_against_list(prims: &[Primitive], rays: &[Ray]) -> usize {
                 *hit,
                 "{name}: closest hit differs for {ray:?}"
             );
+            // Into an answer that holds some other ray's hit, as a reused slot does.
+            let mut into = Some(Hit::new(0.5, u32::MAX - 1, 0.25, 0.25));
+            accel.closest_hit_into(prims, &PreparedRay::new(*ray), &mut into);
+            assert_eq!(into, *hit, "{name}: closest_hit_into differs for {ray:?}");
             assert_eq!(
                 accel.occluded(prims, &PreparedRay::new(*ray)),
                 *occluded,

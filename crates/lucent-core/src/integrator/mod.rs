@@ -14,7 +14,7 @@ pub mod whitted;
 
 use crate::hit::{Hit, SurfacePoint};
 use crate::math::Color;
-use crate::ray::Ray;
+use crate::ray::{PreparedRay, Ray};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
 
@@ -54,14 +54,17 @@ pub enum CameraHit {
 }
 
 impl CameraHit {
-    /// The closest hit of `ray` (counting the ray): the one found already, else traced.
-    /// Leaves `self` untraced, so that it serves the camera ray only.
+    /// The closest hit of `ray` (counting the ray) into `out`: the one found already, else
+    /// traced. Leaves `self` untraced, so that it serves the camera ray only. (Into the
+    /// caller's answer, which the caller reads by reference: a copy of a hit the search
+    /// has just written piece by piece would be read back whole, a stalled store-to-load
+    /// forward on every ray.)
     #[inline]
-    pub fn take(&mut self, scene: &Scene, ray: &Ray, counts: &mut TraceCounts) -> Option<Hit> {
+    pub fn take_into(&mut self, scene: &Scene, ray: &Ray, counts: &mut TraceCounts, out: &mut Option<Hit>) {
         counts.rays += 1;
         match std::mem::take(self) {
-            CameraHit::Traced(hit) => hit,
-            CameraHit::Untraced => scene.closest_hit(ray),
+            CameraHit::Traced(hit) => *out = hit,
+            CameraHit::Untraced => scene.closest_hit_into(&PreparedRay::new(*ray), out),
         }
     }
 }
@@ -77,13 +80,15 @@ pub(crate) enum FirstHit {
 
 /// Traces `ray` (counting it; `camera` may hold its hit already) and says what it meets.
 pub(crate) fn first_hit(scene: &Scene, ray: &Ray, camera: &mut CameraHit, counts: &mut TraceCounts) -> FirstHit {
-    let Some(hit) = camera.take(scene, ray, counts) else {
+    let mut found = None;
+    camera.take_into(scene, ray, counts, &mut found);
+    let Some(hit) = &found else {
         return FirstHit::Nothing;
     };
-    let sp = scene.surface_point(&hit, ray);
+    let sp = scene.surface_point(hit, ray);
     match sp.light {
         Some(light) => FirstHit::Light(scene.lights[light as usize].radiance_seen(ray.dir, sp.normal)),
-        None => FirstHit::Surface(hit, sp),
+        None => FirstHit::Surface(*hit, sp),
     }
 }
 

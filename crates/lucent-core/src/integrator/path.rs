@@ -191,7 +191,9 @@ impl Integrator for PathTracer {
         // The index of the vertex the current segment will hit.
         let mut k = 1u32;
         loop {
-            let Some(hit) = camera.take(scene, &ray, counts) else {
+            let mut found = None;
+            camera.take_into(scene, &ray, counts, &mut found);
+            let Some(hit) = &found else {
                 // The environment (black without one), a light like any other.
                 if let Some(env) = &scene.environment {
                     let le = env.radiance(ray.dir);

@@ -147,7 +147,11 @@ fn answer(accel: &dyn Accelerator<Queried>, prims: &Queried, ray: &Ray, occluded
             (f32::INFINITY, 0)
         }
     } else {
-        match accel.closest_hit(prims, ray) {
+        // (Into a local read by reference, as the renderer does: see
+        // `Accelerator::closest_hit_into`.)
+        let mut hit = None;
+        accel.closest_hit_into(prims, ray, &mut hit);
+        match &hit {
             Some(h) => (h.t, h.prim),
             None => (f32::INFINITY, MISS),
         }

@@ -229,6 +229,8 @@ trait Query<P: PrimitiveSet + ?Sized> {
     /// Whether the query visits children nearest first (and so needs their entry
     /// distances): closest hits do, any-hit queries do not.
     const ORDERED: bool;
+    /// Writes the answer to `out` (the closest hit is searched for in it).
+    ///
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
     /// direction component, and the tree at most `STACK / (WIDTH - 1)` levels deep.
@@ -237,7 +239,8 @@ trait Query<P: PrimitiveSet + ?Sized> {
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
-    ) -> Self::Answer;
+        out: &mut Self::Answer,
+    );
 }
 
 struct Closest;
@@ -253,8 +256,9 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
-    ) -> Option<Hit> {
-        traverse::closest::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
+        out: &mut Option<Hit>,
+    ) {
+        traverse::closest::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb, out)
     }
 }
 
@@ -268,8 +272,9 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
-    ) -> bool {
-        traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
+        out: &mut bool,
+    ) {
+        *out = traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
     }
 }
 
@@ -279,8 +284,8 @@ use traverse::{DEEP_STACK, SHALLOW_STACK};
 /// that have its constants, the plain one for the others. Shallow trees only.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
-    run_fused::<Q, P>(b, prims, r)
+unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
+    run_fused::<Q, P>(b, prims, r, out)
 }
 
 /// The AVX-512 paths. Closest hits run the same code as [`run_avx2`] (the same 8-lane
@@ -295,10 +300,10 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
 /// distances. (On a CPU with full-width AVX-512 this is still to be measured.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
-unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
     use box_test::Fused;
     if Q::ORDERED {
-        return run_fused::<Q, P>(b, prims, r);
+        return run_fused::<Q, P>(b, prims, r, out);
     }
     match FmaOffsets::new(r) {
         Some(offsets) => Q::run::<Fused<lanes::Avx512>, false, SHALLOW_STACK>(
@@ -306,8 +311,9 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, 
             prims,
             r,
             &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
+            out,
         ),
-        None => run_avx2_plain::<Q, P>(b, prims, r),
+        None => run_avx2_plain::<Q, P>(b, prims, r, out),
     }
 }
 
@@ -315,15 +321,21 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, 
 /// with its caller's instruction set.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
     // The ray's constants are made here, in this function, rather than passed in: handing
     // them over through memory costs a stalled store-to-load forward per ray.
     use box_test::Fused;
     use lanes::Avx;
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(b, prims, r, &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes))
+        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(
+            b,
+            prims,
+            r,
+            &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
+            out,
+        )
     } else {
-        run_avx2_plain::<Q, P>(b, prims, r)
+        run_avx2_plain::<Q, P>(b, prims, r, out)
     }
 }
 
@@ -333,34 +345,44 @@ unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r
 #[target_feature(enable = "avx2,fma")]
 #[inline(never)]
 #[cold]
-unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Answer,
+) {
     use lanes::Avx;
     // (Made here, not passed in: a reference to it would make the common path store it.)
     let rb = RayBoxes::new(r);
     if r.zero_axes.any() {
-        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
+        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
     } else {
-        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
+        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
     }
 }
 
 /// The paths without AVX2, shallow trees only; out of line, so that their frames do not
 /// add to the AVX2 path's caller.
 #[inline(never)]
-unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Answer,
+) {
     let zero = r.zero_axes.any();
     let rb = RayBoxes::new(r);
     match b.isa {
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 if zero => {
-            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
+            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
         }
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
+            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
         }
-        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes)),
-        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes)),
+        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
+        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
     }
 }
 
@@ -369,22 +391,33 @@ unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P
 /// answers depend on, so the answers are the same) with the large stack.
 #[cold]
 #[inline(never)]
-unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay) -> Q::Answer {
+unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
     let rb = RayBoxes::new(r);
     match b.isa {
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes))
+            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
         }
-        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes)),
+        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
     }
 }
 
 impl Bvh {
     #[inline(always)]
     fn query<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay) -> Q::Answer {
+        let mut answer = Q::NONE;
+        self.query_into::<Q, P>(prims, r, &mut answer);
+        answer
+    }
+
+    /// [`Bvh::query`] into the caller's answer: the traversal keeps its best hit there,
+    /// so that no copy of it (written piece by piece as hits are found, read back whole)
+    /// stalls the end of every closest-hit query on a store-to-load forward.
+    #[inline(always)]
+    fn query_into<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
         if self.nodes.is_empty() {
-            return Q::NONE;
+            *out = Q::NONE;
+            return;
         }
         // SAFETY: node and packet references were built by `wide::collapse` for these
         // primitives, with at most `MAX_LEVELS` levels (asserted at build) and at most
@@ -392,14 +425,14 @@ impl Bvh {
         // AVX2 and FMA (`isa` checked at build); SSE2 is part of x86-64.
         unsafe {
             if self.deep {
-                return run_deep::<Q, P>(self, prims, r);
+                return run_deep::<Q, P>(self, prims, r, out);
             }
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => run_avx512::<Q, P>(self, prims, r),
+                Isa::Avx512 => run_avx512::<Q, P>(self, prims, r, out),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => run_avx2::<Q, P>(self, prims, r),
-                _ => run_portable::<Q, P>(self, prims, r),
+                Isa::Avx2 => run_avx2::<Q, P>(self, prims, r, out),
+                _ => run_portable::<Q, P>(self, prims, r, out),
             }
         }
     }
@@ -408,6 +441,10 @@ impl Bvh {
 impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
     fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
         self.query::<Closest, P>(prims, r)
+    }
+
+    fn closest_hit_into(&self, prims: &P, r: &PreparedRay, out: &mut Option<Hit>) {
+        self.query_into::<Closest, P>(prims, r, out)
     }
 
     fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {

@@ -116,7 +116,8 @@ fn entry(dist: f32, reference: u32) -> u64 {
     (dist.to_bits() as u64) << 32 | reference as u64
 }
 
-/// The closest hit of `r` in the tree.
+/// The closest hit of `r` in the tree, into `best` (the caller's answer, so that the hit
+/// is not copied out of a local of this function).
 ///
 /// # Safety
 /// The nodes and packets must be one tree built for `prims`, of at most
@@ -128,8 +129,9 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
     prims: &P,
     r: &PreparedRay,
     rb: &T::Ray,
-) -> Option<Hit> {
-    let mut best = None;
+    best: &mut Option<Hit>,
+) {
+    *best = None;
     let mut t_max = r.ray.t_max;
     // Boxes are searched a little past the closest hit (ties); kept up to date with it.
     let mut limit = search_limit(t_max);
@@ -178,13 +180,13 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
             }
         } else {
             for p in leaf_packets(cur) {
-                packets.get_unchecked(p).closest(prims, r, &mut t_max, &mut best);
+                packets.get_unchecked(p).closest(prims, r, &mut t_max, best);
             }
             limit = search_limit(t_max);
         }
         loop {
             if sp == 0 {
-                return best;
+                return;
             }
             sp -= 1;
             let e = stack.get_unchecked(sp).assume_init();

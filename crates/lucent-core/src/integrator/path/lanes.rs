@@ -192,14 +192,17 @@ fn run(
             live = true;
             let first = k[i] == 1;
             counts.rays += 1;
-            let hit = if first {
-                camera_hits[sample[i]]
+            let mut hit = None;
+            if first {
+                hit = camera_hits[sample[i]];
             } else {
-                scene.closest_hit_prepared(&paths.bounce.ray.get(i))
-            };
+                scene.closest_hit_into(&paths.bounce.ray.get(i), &mut hit);
+            }
             paths.rays[i] = None;
             // A segment that escapes finds nothing (no environment here).
-            let Some(hit) = hit else {
+            // (By reference: a copy would read the hit back whole just after the search
+            // wrote it piece by piece, a stalled store-to-load forward.)
+            let Some(hit) = &hit else {
                 continue;
             };
             let came = if first {
@@ -221,7 +224,7 @@ fn run(
                     prim.material
                 }
                 _ => {
-                    let sp = scene.surface_point(&hit, &ray);
+                    let sp = scene.surface_point(hit, &ray);
                     if let Some(index) = sp.light {
                         let light = &scene.lights[index as usize];
                         let le = light.radiance_seen(ray.dir, sp.normal);

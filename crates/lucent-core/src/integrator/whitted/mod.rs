@@ -207,7 +207,9 @@ impl Whitted {
             if self.leave_out(t, weight, pending) {
                 return;
             }
-            let Some(hit) = t.camera.take(scene, &ray, t.counts) else {
+            let mut found = None;
+            t.camera.take_into(scene, &ray, t.counts, &mut found);
+            let Some(hit) = &found else {
                 if let Some(env) = &scene.environment {
                     *total += weight * env.radiance(ray.dir);
                 }
