@@ -146,7 +146,7 @@ impl Bvh {
             prims,
             rays,
             |i, s| out[i] = s.1,
-            |r| (0.0, self.query::<Closest, P>(prims, &PreparedRay::new(*r))),
+            |r| (0.0, self.closest_hit(prims, &PreparedRay::new(*r))),
         );
     }
 
@@ -158,7 +158,7 @@ impl Bvh {
             prims,
             rays,
             |i, s| out[i] = s.1,
-            |r| (0.0, self.query::<Occluded, P>(prims, &PreparedRay::new(*r))),
+            |r| (0.0, self.occluded(prims, &PreparedRay::new(*r))),
         );
     }
 
@@ -224,13 +224,18 @@ impl Bvh {
 
 /// The two queries, so that the choice of box test is written once.
 trait Query<P: PrimitiveSet + ?Sized> {
+    /// Where the query keeps its answer as it goes: the caller's closest hit (searched
+    /// for in place: a hit copied out of the traversal would be read back whole just
+    /// after it was written piece by piece, a stalled store-to-load forward per ray), or
+    /// nothing for any-hit queries, which return theirs in a register.
+    type Out;
+    /// What the query returns.
     type Answer;
-    const NONE: Self::Answer;
+    /// The answer when the tree is empty.
+    fn nothing(out: &mut Self::Out) -> Self::Answer;
     /// Whether the query visits children nearest first (and so needs their entry
     /// distances): closest hits do, any-hit queries do not.
     const ORDERED: bool;
-    /// Writes the answer to `out` (the closest hit is searched for in it).
-    ///
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
     /// direction component, and the tree at most `STACK / (WIDTH - 1)` levels deep.
@@ -239,16 +244,19 @@ trait Query<P: PrimitiveSet + ?Sized> {
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
-        out: &mut Self::Answer,
-    );
+        out: &mut Self::Out,
+    ) -> Self::Answer;
 }
 
 struct Closest;
 struct Occluded;
 
 impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
-    type Answer = Option<Hit>;
-    const NONE: Option<Hit> = None;
+    type Out = Option<Hit>;
+    type Answer = ();
+    fn nothing(out: &mut Option<Hit>) {
+        *out = None;
+    }
     const ORDERED: bool = true;
     #[inline(always)]
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
@@ -263,8 +271,11 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
 }
 
 impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
+    type Out = ();
     type Answer = bool;
-    const NONE: bool = false;
+    fn nothing(_: &mut ()) -> bool {
+        false
+    }
     const ORDERED: bool = false;
     #[inline(always)]
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
@@ -272,9 +283,9 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
-        out: &mut bool,
-    ) {
-        *out = traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
+        _: &mut (),
+    ) -> bool {
+        traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
     }
 }
 
@@ -284,7 +295,12 @@ use traverse::{DEEP_STACK, SHALLOW_STACK};
 /// that have its constants, the plain one for the others. Shallow trees only.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
+unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Out,
+) -> Q::Answer {
     run_fused::<Q, P>(b, prims, r, out)
 }
 
@@ -300,7 +316,12 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
 /// distances. (On a CPU with full-width AVX-512 this is still to be measured.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
-unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
+unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Out,
+) -> Q::Answer {
     use box_test::Fused;
     if Q::ORDERED {
         return run_fused::<Q, P>(b, prims, r, out);
@@ -321,7 +342,12 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, 
 /// with its caller's instruction set.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
+unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Out,
+) -> Q::Answer {
     // The ray's constants are made here, in this function, rather than passed in: handing
     // them over through memory costs a stalled store-to-load forward per ray.
     use box_test::Fused;
@@ -349,8 +375,8 @@ unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     b: &Bvh,
     prims: &P,
     r: &PreparedRay,
-    out: &mut Q::Answer,
-) {
+    out: &mut Q::Out,
+) -> Q::Answer {
     use lanes::Avx;
     // (Made here, not passed in: a reference to it would make the common path store it.)
     let rb = RayBoxes::new(r);
@@ -368,8 +394,8 @@ unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     b: &Bvh,
     prims: &P,
     r: &PreparedRay,
-    out: &mut Q::Answer,
-) {
+    out: &mut Q::Out,
+) -> Q::Answer {
     let zero = r.zero_axes.any();
     let rb = RayBoxes::new(r);
     match b.isa {
@@ -391,7 +417,12 @@ unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 /// answers depend on, so the answers are the same) with the large stack.
 #[cold]
 #[inline(never)]
-unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
+unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    b: &Bvh,
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Out,
+) -> Q::Answer {
     let rb = RayBoxes::new(r);
     match b.isa {
         #[cfg(target_arch = "x86_64")]
@@ -403,21 +434,11 @@ unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(b: &Bvh, prims: &P, r:
 }
 
 impl Bvh {
+    /// One query (see [`Query::Out`] for `out`).
     #[inline(always)]
-    fn query<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay) -> Q::Answer {
-        let mut answer = Q::NONE;
-        self.query_into::<Q, P>(prims, r, &mut answer);
-        answer
-    }
-
-    /// [`Bvh::query`] into the caller's answer: the traversal keeps its best hit there,
-    /// so that no copy of it (written piece by piece as hits are found, read back whole)
-    /// stalls the end of every closest-hit query on a store-to-load forward.
-    #[inline(always)]
-    fn query_into<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, out: &mut Q::Answer) {
+    fn query<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, out: &mut Q::Out) -> Q::Answer {
         if self.nodes.is_empty() {
-            *out = Q::NONE;
-            return;
+            return Q::nothing(out);
         }
         // SAFETY: node and packet references were built by `wide::collapse` for these
         // primitives, with at most `MAX_LEVELS` levels (asserted at build) and at most
@@ -440,15 +461,17 @@ impl Bvh {
 
 impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
     fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
-        self.query::<Closest, P>(prims, r)
+        let mut best = None;
+        self.query::<Closest, P>(prims, r, &mut best);
+        best
     }
 
     fn closest_hit_into(&self, prims: &P, r: &PreparedRay, out: &mut Option<Hit>) {
-        self.query_into::<Closest, P>(prims, r, out)
+        self.query::<Closest, P>(prims, r, out)
     }
 
     fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {
-        self.query::<Occluded, P>(prims, r)
+        self.query::<Occluded, P>(prims, r, &mut ())
     }
 
     fn memory_bytes(&self) -> usize {
