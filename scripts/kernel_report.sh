@@ -7,8 +7,9 @@
 # env: WORK (default /tmp/lucent-kernel-report: the ray files, Embree's harness and the logs;
 #      give the same WORK again to reuse them), ROUNDS (default 7: rounds of compare4.sh),
 #      PACKET_ROUNDS (default 7: rounds of compare_packets.sh), BUILD_PAIRS (default 7: paired
-#      runs of the 1- and 2-thread builds), BENCH (default ../shared/bench), MESHES (default:
-#      both dragons of BENCH)
+#      runs of the 1- and 2-thread builds), ISA_ROUNDS (default 5: paired rounds of the AVX-512
+#      paths against the AVX2 paths; 0 leaves that step out), BENCH (default ../shared/bench),
+#      MESHES (default: both dragons of BENCH)
 #
 # Steps, each logged to WORK/*.txt and summed up in WORK/report.md:
 #   1. `lscpu`'s model and AVX-512 flags;
@@ -18,7 +19,10 @@
 #      with apt-get when neither it nor earlier ray files in WORK are there;
 #   3. scripts/compare_packets.sh (lucent's packets against Embree 4's 8- and 16-wide ones);
 #   4. the BVH build of the largest mesh on 1 and 2 threads, paired (median of the per-pair
-#      ratios), and bytes per triangle.
+#      ratios), and bytes per triangle;
+#   5. on a CPU with AVX-512 only: the same binary's AVX-512 paths (the default there) against
+#      its AVX2 paths (`--isa avx2`, scripts/lucent_avx2.sh), paired with paired_rays.sh, on
+#      every set, single rays and packets: whether AVX-512 pays on this machine.
 # Takes about an hour on two cores with the defaults; use ROUNDS=1 PACKET_ROUNDS=1
 # BUILD_PAIRS=1 for a quick look.
 set -eu
@@ -28,7 +32,7 @@ lucent=$(realpath "${1:-$here/../target/release/lucent}")
 bench=$(realpath "${BENCH:-$here/../../shared/bench}")
 [ -d "$bench" ] || { echo "kernel_report.sh: no benchmark folder at $bench (set BENCH)" >&2; exit 2; }
 WORK=${WORK:-/tmp/lucent-kernel-report}
-ROUNDS=${ROUNDS:-7}; PACKET_ROUNDS=${PACKET_ROUNDS:-7}; BUILD_PAIRS=${BUILD_PAIRS:-7}
+ROUNDS=${ROUNDS:-7}; PACKET_ROUNDS=${PACKET_ROUNDS:-7}; BUILD_PAIRS=${BUILD_PAIRS:-7}; ISA_ROUNDS=${ISA_ROUNDS:-5}
 read -r -a meshes <<< "${MESHES:-$bench/dragon_100k.obj $bench/dragon_1m6.obj.gz}"
 mkdir -p "$WORK"
 report=$WORK/report.md
@@ -56,18 +60,18 @@ fi
   echo
 } > "$report"
 
-echo "# 1/3 single rays: compare4.sh, ROUNDS=$ROUNDS" >&2
+echo "# 1/4 single rays: compare4.sh, ROUNDS=$ROUNDS" >&2
 ROUNDS=$ROUNDS WORK=$WORK "$bench/compare4.sh" "$lucent" "${meshes[@]}" > "$WORK/compare4.txt" 2> "$WORK/compare4.err.txt" \
   || { echo "kernel_report.sh: compare4.sh failed, see $WORK/compare4.err.txt" >&2; exit 1; }
 { echo "## Single rays and builds (compare4.sh)"; echo; echo '```'; cat "$WORK/compare4.txt"; echo '```'; echo; } >> "$report"
 
-echo "# 2/3 packets: compare_packets.sh, ROUNDS=$PACKET_ROUNDS" >&2
+echo "# 2/4 packets: compare_packets.sh, ROUNDS=$PACKET_ROUNDS" >&2
 ROUNDS=$PACKET_ROUNDS "$here/compare_packets.sh" "$lucent" "$WORK" "${meshes[@]}" > "$WORK/packets.txt" 2> "$WORK/packets.err.txt" \
   || { echo "kernel_report.sh: compare_packets.sh failed, see $WORK/packets.err.txt" >&2; exit 1; }
 { echo "## Packets (compare_packets.sh)"; echo; echo '```'; cat "$WORK/packets.txt"; echo '```'; echo; } >> "$report"
 
 # The build on 1 and 2 threads: a few rays only, so that the run is the build.
-echo "# 3/3 build threads, $BUILD_PAIRS pairs" >&2
+echo "# 3/4 build threads, $BUILD_PAIRS pairs" >&2
 last=${meshes[${#meshes[@]}-1]}
 name=$(basename "$last" .gz); name=${name%.obj}
 obj=$last; [[ $last == *.gz ]] && obj=$WORK/$name.obj
@@ -98,5 +102,30 @@ print(f"- 2 threads over 1, median of {n} paired ratios: **{statistics.median(ra
       f"[{ratios[n // 4]:.2f}–{ratios[(3 * n) // 4]:.2f}] (target ≥ 1.7×)")
 print(f"- memory: {bytes_per_tri} bytes per triangle (target ≤ 55)\n")
 PY
+
+# The AVX-512 paths against the AVX2 paths of the same binary (the ratio is AVX-512 / AVX2).
+if [ "$ISA_ROUNDS" -gt 0 ] && grep -q -w avx512f /proc/cpuinfo; then
+  echo "# 4/4 AVX-512 paths against AVX2 paths, ISA_ROUNDS=$ISA_ROUNDS" >&2
+  {
+    echo "## AVX-512 paths against AVX2 paths (\`paired_rays.sh\`, $ISA_ROUNDS rounds; above 1: AVX-512 is faster)"
+    echo
+    echo '```'
+  } >> "$report"
+  for mesh in "${meshes[@]}"; do
+    name=$(basename "$mesh" .gz); name=${name%.obj}
+    obj=$mesh; [[ $mesh == *.gz ]] && obj=$WORK/$name.obj
+    for set in primary diffuse shadow; do
+      for mode in single packets; do
+        [ $mode = packets ] && [ $set = diffuse ] && continue   # no renderer path traces these in packets
+        opts=(); [ $set = shadow ] && opts+=(--occluded); [ $mode = packets ] && opts+=(--packets)
+        line=$(LUCENT=$lucent ROUNDS=$ISA_ROUNDS "$here/paired_rays.sh" "$obj" "$WORK/$name/$set.rays" \
+                 "$here/lucent_avx2.sh" "$lucent" "${opts[@]}" 2>> "$WORK/isa.err.txt" | head -1) \
+          || { echo "kernel_report.sh: paired_rays.sh failed, see $WORK/isa.err.txt" >&2; exit 1; }
+        echo "$name $set $mode: ${line#*: }" >> "$report"
+      done
+    done
+  done
+  echo '```' >> "$report"
+fi
 cat "$report"
 echo "# report: $report" >&2
