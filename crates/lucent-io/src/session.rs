@@ -134,6 +134,12 @@ impl Renderer {
         self.pool.current_num_threads()
     }
 
+    /// Runs `work` on these workers: whatever it does in parallel (a scene's build: its
+    /// BVH, its meshes) uses their number of threads, not one per core.
+    pub fn install<R: Send>(&self, work: impl FnOnce() -> R + Send) -> R {
+        self.pool.install(work)
+    }
+
     /// Renders `job` of a built scene; `progress` hears of every finished tile's pixels,
     /// and setting `cancel` stops the render (`None`).
     pub fn render(

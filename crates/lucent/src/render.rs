@@ -44,7 +44,8 @@ pub struct RenderArgs {
     /// else raytrace.png (with several scenes: SCENE.png beside each).
     #[arg(short, long, value_name = "OUT.png")]
     pub output: Option<PathBuf>,
-    /// Worker threads (default: all cores). The image is the same for any count.
+    /// Worker threads for the build and the render (default: all cores). The image is the
+    /// same for any count.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
     /// Samples per pixel, instead of the scene's `spp` (as pbrt's --spp).
@@ -309,17 +310,17 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
             return EXIT_BAD_INPUT;
         }
     }
+    let renderer = match start_renderer(args.threads) {
+        Ok(r) => r,
+        Err(code) => return code,
+    };
+    // The build on the render's workers: `--threads` bounds the whole run.
     let building = Progress::phase("building", args.quiet);
-    session.build();
+    renderer.install(|| session.build());
     building.finish();
     report(&session.diags, &session.desc.sources, false);
     let Some(built) = &session.built else {
         return EXIT_BAD_INPUT;
-    };
-
-    let renderer = match start_renderer(args.threads) {
-        Ok(r) => r,
-        Err(code) => return code,
     };
     let extras = Extras {
         aovs: args.aov.unwrap_or_default(),

@@ -92,7 +92,7 @@ pub(crate) fn first_hit(scene: &Scene, ray: &Ray, camera: &mut CameraHit, counts
     }
 }
 
-pub trait Integrator: Sync {
+pub trait Integrator: Send + Sync {
     /// Radiance arriving along the camera ray `ray` (whose closest hit `camera` may hold
     /// already); `sampler` gives the sample's random numbers, and `counts` counts what
     /// was traced on the way.

@@ -20,7 +20,7 @@ pub struct SceneBenchArgs {
     /// Renders to time (the median is reported).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub reps: u32,
-    /// Worker threads (default: all cores).
+    /// Worker threads for the build and the renders (default: all cores).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
     #[arg(long, default_value = "bvh", value_parser = clap::builder::PossibleValuesParser::new(AccelKind::NAMES))]
@@ -33,17 +33,18 @@ pub fn run(args: &SceneBenchArgs) -> u8 {
         accel,
         ..SessionOptions::default()
     };
-    let session = Session::open(&args.scene, options);
+    let renderer = match crate::render::start_renderer(args.threads) {
+        Ok(r) => r,
+        Err(code) => return code,
+    };
+    // Built on the render's workers, as `lucent render` builds.
+    let mut session = Session::parse_file(&args.scene, options);
+    renderer.install(|| session.build());
     report(&session.diags, &session.desc.sources, false);
     let Some(built) = &session.built else {
         return EXIT_BAD_INPUT;
     };
     let (parse_s, build_s) = (session.parse_seconds, session.build_seconds);
-
-    let renderer = match crate::render::start_renderer(args.threads) {
-        Ok(r) => r,
-        Err(code) => return code,
-    };
     let job = built.job();
     let cancel = AtomicBool::new(false);
     let mut times = Vec::new();
