@@ -81,8 +81,10 @@ impl EnvironmentLight {
     }
 
     /// The cell of `(u, v)`, the point's place in it, and the cell's corner values
-    /// (top left, top right, bottom left, bottom right).
-    #[inline]
+    /// (top left, top right, bottom left, bottom right). (Inlined always: returned out of
+    /// line, its six numbers were written one by one and read back as a vector, a stalled
+    /// store-to-load forward on every draw.)
+    #[inline(always)]
     fn cell(&self, u: f32, v: f32) -> ((f32, f32), [f32; 4]) {
         let (x, y) = (u * self.width as f32, v * self.height as f32);
         let (i, j) = ((x as usize).min(self.width - 1), (y as usize).min(self.height - 1));
