@@ -56,9 +56,10 @@ impl Distribution1D {
         *cdf.last_mut().unwrap() = 1.0;
         // (Distributions of more items than a u32 counts go without the table.)
         let n = weights.len();
-        let mut guide = Vec::with_capacity(if n <= u32::MAX as usize { n } else { 0 });
+        let parts = if n <= u32::MAX as usize { n } else { 0 };
+        let mut guide = Vec::with_capacity(parts);
         let mut i = 0;
-        for k in 0..guide.capacity() {
+        for k in 0..parts {
             let start = k as f64 / n as f64;
             while i + 1 < cdf.len() && cdf[i + 1] <= start {
                 i += 1;
