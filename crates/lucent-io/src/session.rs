@@ -9,7 +9,7 @@ use std::time::Instant;
 use lucent_core::accel::AccelKind;
 use lucent_core::film::Film;
 use lucent_core::render::job::RenderJob;
-use lucent_core::render::{render_after, RenderControl, RenderStats};
+use lucent_core::render::{render_after_reusing, RenderControl, RenderStats};
 
 use crate::build::{build, BuildOptions, Built};
 use crate::cse167::{parse_bytes_with, parse_file_with, ParseOptions};
@@ -149,21 +149,23 @@ impl Renderer {
         progress: &(dyn Fn(u64) + Sync),
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats)> {
-        self.render_after(built, job, None, progress, cancel)
+        self.render_after(built, job, None, None, progress, cancel)
     }
 
     /// [`Renderer::render`], continuing `earlier`: the film of the job's pixels' samples
-    /// before `job.samples` ([`render_after`]).
+    /// before `job.samples`; the result goes into `spare` when that is a film of an
+    /// earlier pass that is no longer needed ([`render_after_reusing`]).
     pub fn render_after(
         &self,
         built: &Built,
         job: &RenderJob,
         earlier: Option<&Film>,
+        spare: Option<Film>,
         progress: &(dyn Fn(u64) + Sync),
         cancel: &AtomicBool,
     ) -> Option<(Film, RenderStats)> {
         let control = RenderControl { progress, cancel };
         self.pool
-            .install(|| render_after(&built.scene, built.integrator.as_ref(), job, earlier, &control))
+            .install(|| render_after_reusing(&built.scene, built.integrator.as_ref(), job, earlier, spare, &control))
     }
 }

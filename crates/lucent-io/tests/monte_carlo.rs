@@ -527,3 +527,41 @@ fn monte_carlo_renders_are_the_same_bytes_for_any_thread_count() {
     assert_eq!(one.to_rgb_f32(), two.to_rgb_f32());
     assert_eq!(two.to_rgb_f32(), again.to_rgb_f32());
 }
+
+#[test]
+fn a_pass_rendered_into_an_earlier_pass_film_is_what_a_fresh_film_gets() {
+    // Adaptive sampling with the auxiliary passes, so that every part of a film is used:
+    // the sums, the counts, the AOV sums and the noise estimates. The second pass goes
+    // into the first pass's film (full of other samples) and into a fresh one.
+    use lucent_io::session::{Renderer, Session, SessionOptions};
+    let text = small_box("maxdepth 3\nnexteventestimation mis\nnoisethreshold 0.05", 64);
+    let mut session = Session::parse_text("p.test", text.as_bytes(), SessionOptions::default());
+    session.build();
+    let built = session.built.as_ref().expect("the small box builds");
+    let mut job = built.job();
+    job.aovs = true;
+    let (first, second) = (
+        lucent_core::render::job::RenderJob {
+            samples: 0..20,
+            ..job.clone()
+        },
+        lucent_core::render::job::RenderJob {
+            samples: 20..64,
+            ..job.clone()
+        },
+    );
+    let renderer = Renderer::new(Some(2)).unwrap();
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let (a, _) = renderer
+        .render_after(built, &first, None, None, &|_| {}, &cancel)
+        .unwrap();
+    assert!(a.aovs.is_some() && a.noise.is_some());
+    let (fresh, _) = renderer
+        .render_after(built, &second, Some(&a), None, &|_| {}, &cancel)
+        .unwrap();
+    let (reused, _) = renderer
+        .render_after(built, &second, Some(&a), Some(a.clone()), &|_| {}, &cancel)
+        .unwrap();
+    assert!(fresh.counts.iter().any(|&n| n > 0));
+    assert_eq!(reused, fresh);
+}

@@ -8,6 +8,10 @@
 //! last about an eighth of the time spent so far (at least 2 s, at most the checkpoint
 //! interval or a minute). Adaptive sampling carries each pixel's estimate from pass to
 //! pass in the film, so its decisions are those of one pass too.
+//!
+//! Without a film to resume, the first pass's film becomes the render's; every later
+//! pass renders into the film of the pass before it (whose samples were added), so that
+//! a picture's worth of fresh memory is faulted in once, not once per pass.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -44,8 +48,10 @@ pub fn render_in_passes(
     checkpoint: Option<Duration>,
     save: &mut dyn FnMut(&Film, &Range<u32>),
 ) -> Outcome {
-    let rect = job.pixels;
-    let mut film = start.unwrap_or_else(|| Film::with_aovs(rect.width(), rect.height(), job.aovs));
+    // The samples so far (none yet without `start`: the first pass's film becomes it), and
+    // the film of the pass before, whose memory the next pass uses again.
+    let mut film = start;
+    let mut spare: Option<Film> = None;
     let mut stats: Option<RenderStats> = None;
     let began = Instant::now();
     let mut last_save = Instant::now();
@@ -58,14 +64,23 @@ pub fn render_in_passes(
             ..job.clone()
         };
         let t = Instant::now();
-        let Some((f, s)) = renderer.render_after(built, &pass_job, Some(&film), progress, cancel) else {
+        let Some((f, s)) = renderer.render_after(built, &pass_job, film.as_ref(), spare.take(), progress, cancel)
+        else {
             break;
         };
         if cancel.load(Ordering::Relaxed) {
             break;
         }
         let took = t.elapsed().as_secs_f64();
-        film.add_film(&f);
+        // (Exact sums: the first pass's film is what adding it to an empty one gives.)
+        let so_far = match &mut film {
+            Some(so_far) => {
+                so_far.add_film(&f);
+                spare = Some(f);
+                so_far
+            }
+            None => film.insert(f),
+        };
         match &mut stats {
             Some(total) => total.add(&s),
             None => stats = Some(s),
@@ -73,7 +88,7 @@ pub fn render_in_passes(
         done = pass.end;
         if let Some(every) = checkpoint {
             if last_save.elapsed() >= every && done < job.samples.end {
-                save(&film, &(first..done));
+                save(so_far, &(first..done));
                 last_save = Instant::now();
             }
         }
@@ -84,9 +99,11 @@ pub fn render_in_passes(
         let target = (began.elapsed().as_secs_f64() / 8.0).clamp(2.0_f64.min(cap), cap);
         size = ((target / per_sample.max(1e-9)) as u64).clamp(1, u32::MAX as u64) as u32;
     }
-    match stats {
-        Some(s) if done == job.samples.end => Outcome::Done(film, s),
-        _ if done > job.samples.start || first < job.samples.start => Outcome::Interrupted(Some((film, first..done))),
+    match (stats, film) {
+        (Some(s), Some(film)) if done == job.samples.end => Outcome::Done(film, s),
+        (_, Some(film)) if done > job.samples.start || first < job.samples.start => {
+            Outcome::Interrupted(Some((film, first..done)))
+        }
         _ => Outcome::Interrupted(None),
     }
 }

@@ -50,6 +50,17 @@ impl Film {
         }
     }
 
+    /// No samples any more (the same pixels, and auxiliary passes if it kept them): the
+    /// film of a finished pass made ready for the next in the memory it already has.
+    pub fn clear(&mut self) {
+        self.sums.fill(ExactSum::default());
+        self.counts.fill(0);
+        if let Some(aovs) = &mut self.aovs {
+            aovs.fill(AovSum::default());
+        }
+        self.noise = None;
+    }
+
     /// Adds a pixel's `count` samples, whose radiance sums to `sum` (and whose auxiliary
     /// passes sum to `aov`, kept if the film keeps them).
     #[inline]

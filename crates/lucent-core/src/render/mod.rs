@@ -156,6 +156,24 @@ pub fn render_after(
     earlier: Option<&Film>,
     control: &RenderControl,
 ) -> Option<(Film, RenderStats)> {
+    render_after_reusing(scene, integrator, job, earlier, None, control)
+}
+
+/// [`render_after`] into `spare`, the film of an earlier pass that is no longer needed
+/// (its samples were added elsewhere), cleared, when it is one of the job's pixels and
+/// passes: a picture's worth of fresh memory costs page faults on every pass (a few
+/// percent of a path-traced render in passes of a couple of seconds).
+///
+/// # Panics
+/// As [`render_after`].
+pub fn render_after_reusing(
+    scene: &Scene,
+    integrator: &dyn Integrator,
+    job: &RenderJob,
+    earlier: Option<&Film>,
+    spare: Option<Film>,
+    control: &RenderControl,
+) -> Option<(Film, RenderStats)> {
     if let Err(e) = job.check() {
         panic!("render: {e}");
     }
@@ -185,7 +203,13 @@ pub fn render_after(
     // tile's pixels land does not depend on it.
     let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
     let w = rect.width() as usize;
-    let mut film = Film::with_aovs(rect.width(), rect.height(), job.aovs);
+    let mut film = match spare {
+        Some(mut f) if (f.width, f.height, f.aovs.is_some()) == (rect.width(), rect.height(), job.aovs) => {
+            f.clear();
+            f
+        }
+        _ => Film::with_aovs(rect.width(), rect.height(), job.aovs),
+    };
     if job.noise_threshold.is_some() {
         film.noise = Some(vec![PixelNoise::default(); film.counts.len()]);
     }
