@@ -9,7 +9,7 @@ use std::time::Instant;
 use lucent_core::accel::AccelKind;
 use lucent_core::film::Film;
 use lucent_core::render::job::RenderJob;
-use lucent_core::render::{render_after_reusing, RenderControl, RenderStats};
+use lucent_core::render::{render_after, RenderControl, RenderStats};
 
 use crate::build::{build, BuildOptions, Built};
 use crate::cse167::{parse_bytes_with, parse_file_with, ParseOptions};
@@ -154,7 +154,7 @@ impl Renderer {
 
     /// [`Renderer::render`], continuing `earlier`: the film of the job's pixels' samples
     /// before `job.samples`; the result goes into `spare` when that is a film of an
-    /// earlier pass that is no longer needed ([`render_after_reusing`]).
+    /// earlier pass that is no longer needed ([`render_after`]).
     pub fn render_after(
         &self,
         built: &Built,
@@ -166,6 +166,6 @@ impl Renderer {
     ) -> Option<(Film, RenderStats)> {
         let control = RenderControl { progress, cancel };
         self.pool
-            .install(|| render_after_reusing(&built.scene, built.integrator.as_ref(), job, earlier, spare, &control))
+            .install(|| render_after(&built.scene, built.integrator.as_ref(), job, earlier, spare, &control))
     }
 }

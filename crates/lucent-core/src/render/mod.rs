@@ -140,33 +140,20 @@ pub fn render(
     job: &RenderJob,
     control: &RenderControl,
 ) -> Option<(Film, RenderStats)> {
-    render_after(scene, integrator, job, None, control)
+    render_after(scene, integrator, job, None, None, control)
 }
 
 /// [`render`], continuing `earlier`, the film of the same pixels' samples before
 /// `job.samples` (adaptive sampling goes on from its estimates: a pixel that stopped
-/// there takes no sample here).
+/// there takes no sample here). The result goes into `spare`, cleared, when that is a
+/// film of the job's pixels and passes that is no longer needed (an earlier pass's,
+/// whose samples were added elsewhere): a picture's worth of fresh memory costs page
+/// faults on every pass (a few percent of a path-traced render in passes of a couple of
+/// seconds).
 ///
 /// # Panics
 /// If the job is not valid, or `earlier` is not a film of its pixels.
 pub fn render_after(
-    scene: &Scene,
-    integrator: &dyn Integrator,
-    job: &RenderJob,
-    earlier: Option<&Film>,
-    control: &RenderControl,
-) -> Option<(Film, RenderStats)> {
-    render_after_reusing(scene, integrator, job, earlier, None, control)
-}
-
-/// [`render_after`] into `spare`, the film of an earlier pass that is no longer needed
-/// (its samples were added elsewhere), cleared, when it is one of the job's pixels and
-/// passes: a picture's worth of fresh memory costs page faults on every pass (a few
-/// percent of a path-traced render in passes of a couple of seconds).
-///
-/// # Panics
-/// As [`render_after`].
-pub fn render_after_reusing(
     scene: &Scene,
     integrator: &dyn Integrator,
     job: &RenderJob,
