@@ -10,7 +10,7 @@
 //! `is_x86_feature_detected!`), four at a time with SSE when not; nearest child first,
 //! an explicit fixed-size stack, no allocation per ray; the packet test is bit-identical
 //! to the scalar watertight triangle test, so the answers are exactly the brute-force
-//! list's.
+//! list's. Which box test and lane width a single ray's query runs on this CPU: [`query`].
 //!
 //! Coherent rays can also travel in packets ([`ray_packet`]): eight rays with AVX2,
 //! sixteen with AVX-512 ([`Bvh::closest_hits`], [`Bvh::occluded_rays`]).
@@ -23,6 +23,7 @@ mod lanes;
 mod packet;
 mod packet_frustum;
 mod packet_rays;
+mod query;
 mod ray_lanes;
 pub mod ray_packet;
 mod ray_triangle;
@@ -34,8 +35,8 @@ use super::{Accelerator, PrimitiveSet};
 use crate::hit::Hit;
 use crate::huge_pages;
 use crate::ray::{PreparedRay, Ray};
-use box_test::{BoxTest, FmaOffsets, RayBoxes, Slab};
 use packet::Packet;
+use query::{Closest, Occluded};
 use wide::WideNode;
 
 /// The instruction set the traversal uses on this CPU.
@@ -219,243 +220,6 @@ impl Bvh {
             .iter()
             .flat_map(|p| (0..packet::LANES).filter_map(|l| p.prim(l)))
             .collect()
-    }
-}
-
-/// The two queries, so that the choice of box test is written once.
-trait Query<P: PrimitiveSet + ?Sized> {
-    /// Where the query keeps its answer as it goes: the caller's closest hit (searched
-    /// for in place: a hit copied out of the traversal would be read back whole just
-    /// after it was written piece by piece, a stalled store-to-load forward per ray), or
-    /// nothing for any-hit queries, which return theirs in a register.
-    type Out;
-    /// What the query returns.
-    type Answer;
-    /// The answer when the tree is empty.
-    fn nothing(out: &mut Self::Out) -> Self::Answer;
-    /// Whether the query visits children nearest first (and so needs their entry
-    /// distances): closest hits do, any-hit queries do not.
-    const ORDERED: bool;
-    /// # Safety
-    /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
-    /// direction component, and the tree at most `STACK / (WIDTH - 1)` levels deep.
-    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
-        b: &Bvh,
-        prims: &P,
-        r: &PreparedRay,
-        rb: &T::Ray,
-        out: &mut Self::Out,
-    ) -> Self::Answer;
-}
-
-struct Closest;
-struct Occluded;
-
-impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
-    type Out = Option<Hit>;
-    type Answer = ();
-    fn nothing(out: &mut Option<Hit>) {
-        *out = None;
-    }
-    const ORDERED: bool = true;
-    #[inline(always)]
-    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
-        b: &Bvh,
-        prims: &P,
-        r: &PreparedRay,
-        rb: &T::Ray,
-        out: &mut Option<Hit>,
-    ) {
-        traverse::closest::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb, out)
-    }
-}
-
-impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
-    type Out = ();
-    type Answer = bool;
-    fn nothing(_: &mut ()) -> bool {
-        false
-    }
-    const ORDERED: bool = false;
-    #[inline(always)]
-    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
-        b: &Bvh,
-        prims: &P,
-        r: &PreparedRay,
-        rb: &T::Ray,
-        _: &mut (),
-    ) -> bool {
-        traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
-    }
-}
-
-use traverse::{DEEP_STACK, SHALLOW_STACK};
-
-/// The AVX2 paths, compiled with AVX2 and FMA enabled: the fused box test for rays
-/// that have its constants, the plain one for the others. Shallow trees only.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    run_fused::<Q, P>(b, prims, r, out)
-}
-
-/// The AVX-512 paths. Closest hits run the same code as [`run_avx2`] (the same 8-lane
-/// operations, two groups per node), compiled with AVX-512 VL: 32 vector registers, so
-/// the ray's constants stay in registers, and comparisons into mask registers (measured
-/// on an AMD EPYC, Zen 4: 1.05–1.11× faster than the AVX2 build). Any-hit queries test
-/// a node's sixteen boxes as one 16-lane group ([`lanes::Avx512`]): 1.037× on both
-/// dragons' shadow rays on that CPU. Closest hits lost 7 % that way there (0.927): they
-/// read the children's entry distances back from memory to order them, and storing the
-/// distances as two 256-bit halves brought that to 0.975, so part of the loss is Zen 4
-/// forwarding a 512-bit store to the loads that follow; any-hit queries need no
-/// distances. (On a CPU with full-width AVX-512 this is still to be measured.)
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
-unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    use box_test::Fused;
-    if Q::ORDERED {
-        return run_fused::<Q, P>(b, prims, r, out);
-    }
-    match FmaOffsets::new(r) {
-        Some(offsets) => Q::run::<Fused<lanes::Avx512>, false, SHALLOW_STACK>(
-            b,
-            prims,
-            r,
-            &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
-            out,
-        ),
-        None => run_avx2_plain::<Q, P>(b, prims, r, out),
-    }
-}
-
-/// The body of [`run_avx2`] and of [`run_avx512`]'s closest hits, compiled into each
-/// with its caller's instruction set.
-#[cfg(target_arch = "x86_64")]
-#[inline(always)]
-unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    // The ray's constants are made here, in this function, rather than passed in: handing
-    // them over through memory costs a stalled store-to-load forward per ray.
-    use box_test::Fused;
-    use lanes::Avx;
-    if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(
-            b,
-            prims,
-            r,
-            &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
-            out,
-        )
-    } else {
-        run_avx2_plain::<Q, P>(b, prims, r, out)
-    }
-}
-
-/// The rare rays the fused test cannot take; kept out of line so that the common path
-/// has the registers to itself.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-#[inline(never)]
-#[cold]
-unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    use lanes::Avx;
-    // (Made here, not passed in: a reference to it would make the common path store it.)
-    let rb = RayBoxes::new(r);
-    if r.zero_axes.any() {
-        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
-    } else {
-        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
-    }
-}
-
-/// The paths without AVX2, shallow trees only; out of line, so that their frames do not
-/// add to the AVX2 path's caller.
-#[inline(never)]
-unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    let zero = r.zero_axes.any();
-    let rb = RayBoxes::new(r);
-    match b.isa {
-        #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 if zero => {
-            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
-        }
-        #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
-        }
-        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
-        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
-    }
-}
-
-/// Trees deeper than [`traverse::SHALLOW_LEVELS`] (only pathological inputs make them):
-/// the plain box test (it takes every ray; every box test enters the same boxes the
-/// answers depend on, so the answers are the same) with the large stack.
-#[cold]
-#[inline(never)]
-unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    let rb = RayBoxes::new(r);
-    match b.isa {
-        #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
-        }
-        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
-    }
-}
-
-impl Bvh {
-    /// One query (see [`Query::Out`] for `out`).
-    #[inline(always)]
-    fn query<Q: Query<P>, P: PrimitiveSet + ?Sized>(&self, prims: &P, r: &PreparedRay, out: &mut Q::Out) -> Q::Answer {
-        if self.nodes.is_empty() {
-            return Q::nothing(out);
-        }
-        // SAFETY: node and packet references were built by `wide::collapse` for these
-        // primitives, with at most `MAX_LEVELS` levels (asserted at build) and at most
-        // `SHALLOW_LEVELS` unless `deep`; the AVX2 path is only taken when the CPU has
-        // AVX2 and FMA (`isa` checked at build); SSE2 is part of x86-64.
-        unsafe {
-            if self.deep {
-                return run_deep::<Q, P>(self, prims, r, out);
-            }
-            match self.isa {
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => run_avx512::<Q, P>(self, prims, r, out),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => run_avx2::<Q, P>(self, prims, r, out),
-                _ => run_portable::<Q, P>(self, prims, r, out),
-            }
-        }
     }
 }
 
