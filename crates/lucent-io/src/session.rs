@@ -115,6 +115,20 @@ impl Session {
     }
 }
 
+thread_local! {
+    /// A pool of one thread that is this thread itself (rayon's `use_current_thread`),
+    /// made the first time it is asked for on a thread that is in no pool yet, and kept
+    /// for the thread's life: rayon makes the thread that pool's worker for good (its
+    /// registry outlives any handle), so there is one per thread, never dropped before it.
+    /// `None` where rayon cannot make it (the thread is in another pool already).
+    static CALLING_THREAD_POOL: Option<std::sync::Arc<rayon::ThreadPool>> = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .use_current_thread()
+        .build()
+        .ok()
+        .map(std::sync::Arc::new);
+}
+
 /// Worker threads that render jobs.
 pub struct Renderer {
     pool: rayon::ThreadPool,
@@ -134,9 +148,22 @@ impl Renderer {
         self.pool.current_num_threads()
     }
 
-    /// Runs `work` on these workers: whatever it does in parallel (a scene's build: its
-    /// BVH, its meshes) uses their number of threads, not one per core.
-    pub fn install<R: Send>(&self, work: impl FnOnce() -> R + Send) -> R {
+    /// Runs a scene's build (`work`: its BVH, its meshes, whatever it does in parallel)
+    /// within the render's thread count. With one worker it runs on the calling thread,
+    /// which would only wait for it otherwise: a one-thread run uses one core, and its
+    /// worker's CPU time is the render's alone (what a side-by-side comparison that times
+    /// the sampling by the worker threads' CPU time takes it to be). With more, on the
+    /// workers.
+    pub fn build<R: Send>(&self, work: impl FnOnce() -> R + Send) -> R {
+        if self.threads() == 1 {
+            if rayon::current_thread_index().is_some() && rayon::current_num_threads() == 1 {
+                // Already a one-thread pool's thread (this one's, from an earlier build).
+                return work();
+            }
+            if let Some(pool) = CALLING_THREAD_POOL.with(|p| p.clone()) {
+                return pool.install(work);
+            }
+        }
         self.pool.install(work)
     }
 
@@ -167,5 +194,33 @@ impl Renderer {
         let control = RenderControl { progress, cancel };
         self.pool
             .install(|| render_after(&built.scene, built.integrator.as_ref(), job, earlier, spare, &control))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Renderer;
+    use std::thread::{current, ThreadId};
+
+    /// The threads both halves of a parallel join ran on, and the pool's width there.
+    fn joined() -> (ThreadId, ThreadId, usize) {
+        let (a, b) = rayon::join(|| current().id(), || current().id());
+        (a, b, rayon::current_num_threads())
+    }
+
+    #[test]
+    fn a_one_thread_build_runs_on_the_calling_thread_and_a_wider_one_on_the_workers() {
+        let here = current().id();
+        let one = Renderer::new(Some(1)).unwrap();
+        // Twice: the second time the thread is in its one-thread pool already.
+        for _ in 0..2 {
+            assert_eq!(one.build(joined), (here, here, 1));
+        }
+        let two = Renderer::new(Some(2)).unwrap();
+        let (a, b, width) = two.build(joined);
+        assert_eq!(width, 2);
+        assert!(a != here && b != here);
+        // And the one-thread build still finds this thread after a wider one.
+        assert_eq!(one.build(joined), (here, here, 1));
     }
 }

@@ -44,8 +44,9 @@ pub struct RenderArgs {
     /// else raytrace.png (with several scenes: SCENE.png beside each).
     #[arg(short, long, value_name = "OUT.png")]
     pub output: Option<PathBuf>,
-    /// Worker threads for the build and the render (default: all cores). The image is the
-    /// same for any count.
+    /// Threads for the build and the render (default: all cores; with 1, one core: the
+    /// build runs on the main thread, the render on one worker). The image is the same
+    /// for any count.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
     /// Samples per pixel, instead of the scene's `spp` (as pbrt's --spp).
@@ -314,9 +315,9 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         Ok(r) => r,
         Err(code) => return code,
     };
-    // The build on the render's workers: `--threads` bounds the whole run.
+    // The build within the render's thread count: `--threads` bounds the whole run.
     let building = Progress::phase("building", args.quiet);
-    renderer.install(|| session.build());
+    renderer.build(|| session.build());
     building.finish();
     report(&session.diags, &session.desc.sources, false);
     let Some(built) = &session.built else {

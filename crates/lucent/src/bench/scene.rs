@@ -37,9 +37,9 @@ pub fn run(args: &SceneBenchArgs) -> u8 {
         Ok(r) => r,
         Err(code) => return code,
     };
-    // Built on the render's workers, as `lucent render` builds.
+    // Built as `lucent render` builds.
     let mut session = Session::parse_file(&args.scene, options);
-    renderer.install(|| session.build());
+    renderer.build(|| session.build());
     report(&session.diags, &session.desc.sources, false);
     let Some(built) = &session.built else {
         return EXIT_BAD_INPUT;
