@@ -158,6 +158,13 @@ impl RenderState {
             std::str::from_utf8(&rest[..end])
                 .map_err(|_| "not a lucent state file (its header is not text)".to_string())
         };
+        let not_state = || format!("not a lucent state file (it does not start with '{MAGIC}')");
+        // (Checked first, so that any other file is named for what it is not, not for a
+        // header it never had.)
+        let kind = "lucent-state ".as_bytes();
+        if bytes.is_empty() || !bytes.starts_with(&kind[..bytes.len().min(kind.len())]) {
+            return Err(not_state());
+        }
         match line()? {
             MAGIC => {}
             l if l.starts_with("lucent-state ") => {
@@ -165,7 +172,7 @@ impl RenderState {
                     "a state file of another version of lucent ('{l}'; this one reads '{MAGIC}')"
                 ))
             }
-            _ => return Err(format!("not a lucent state file (it does not start with '{MAGIC}')")),
+            _ => return Err(not_state()),
         }
         // `count` values after the key; `usize::MAX`: the rest of the line as one value.
         let mut field = |key: &str, count: usize| -> Result<Vec<String>, String> {
@@ -512,6 +519,13 @@ mod tests {
         assert!(RenderState::decode(b"lucent-state 1\n")
             .unwrap_err()
             .contains("another version"));
+        // Any other file is named for what it is not, whatever its length or lines.
+        for other in [&[0u8; 4096][..], b"", b"lucent.state", &[b'x'; 300][..]] {
+            let e = RenderState::decode(other).unwrap_err();
+            assert!(e.contains("does not start with"), "{e}");
+        }
+        // A state file's first bytes alone are one cut short.
+        assert!(RenderState::decode(b"lucent-sta").unwrap_err().contains("cut short"));
     }
 
     #[test]
