@@ -2,8 +2,9 @@
 //! terminal, nothing otherwise.
 
 use std::io::IsTerminal;
+use std::time::Duration;
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 
 pub struct Progress {
     bar: ProgressBar,
@@ -17,9 +18,18 @@ impl Progress {
         } else {
             let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr_with_hz(10));
             let style = ProgressStyle::with_template(
-                "rendering {elapsed_precise} [{wide_bar}] {percent:>3}%  {human_pos}/{human_len} samples  ETA {eta_precise}",
+                "rendering {elapsed_precise} [{wide_bar}] {percent:>3}%  {human_pos}/{human_len} samples  ETA {remaining}",
             )
             .expect("valid template")
+            .with_key("remaining", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = match remaining(state.pos(), state.len(), state.elapsed()) {
+                    Some(left) => {
+                        let s = left.as_secs();
+                        write!(w, "{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+                    }
+                    None => write!(w, "--:--:--"),
+                };
+            })
             .progress_chars("=> ");
             bar.set_style(style);
             bar
@@ -51,11 +61,42 @@ impl Progress {
     }
 }
 
+/// The time a render has left at its mean rate since it began (as pbrt and Blender
+/// estimate it), once it has run for a second; before that the rate says little (the
+/// first tiles pay for cold caches and fresh pages: the bar's own estimate, a moving
+/// average, put a 3-second render at nearly 3 minutes), and there is none.
+fn remaining(done: u64, total: Option<u64>, elapsed: Duration) -> Option<Duration> {
+    let total = total?;
+    if elapsed < Duration::from_secs(1) || done == 0 {
+        return None;
+    }
+    let left = total.saturating_sub(done) as f64;
+    Some(Duration::from_secs_f64(elapsed.as_secs_f64() * left / done as f64))
+}
+
 /// Clears a phase's spinner when the phase ends, however it ends.
 pub struct Finish<'a>(pub &'a Progress);
 
 impl Drop for Finish<'_> {
     fn drop(&mut self) {
         self.0.finish();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::remaining;
+    use std::time::Duration;
+
+    #[test]
+    fn the_time_left_is_the_mean_rate_after_the_first_second() {
+        let s = Duration::from_secs;
+        // A quarter done in 3 s: 9 s left; all done: none left.
+        assert_eq!(remaining(250, Some(1000), s(3)), Some(s(9)));
+        assert_eq!(remaining(1000, Some(1000), s(3)), Some(s(0)));
+        // Too early, nothing done yet, or no total: no estimate.
+        assert_eq!(remaining(10, Some(1000), Duration::from_millis(900)), None);
+        assert_eq!(remaining(0, Some(1000), s(5)), None);
+        assert_eq!(remaining(10, None, s(5)), None);
     }
 }
