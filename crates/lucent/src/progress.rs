@@ -63,8 +63,9 @@ impl Progress {
 
 /// The time a render has left at its mean rate since it began (as pbrt and Blender
 /// estimate it), once it has run for a second; before that the rate says little (the
-/// first tiles pay for cold caches and fresh pages: the bar's own estimate, a moving
-/// average, put a 3-second render at nearly 3 minutes), and there is none.
+/// first pass, of one sample per pixel, runs at a rate of its own, and the first tiles
+/// pay for cold caches and fresh pages: the bar's own estimate, a moving average, put a
+/// 3-second render at nearly 3 minutes), and there is none.
 fn remaining(done: u64, total: Option<u64>, elapsed: Duration) -> Option<Duration> {
     let total = total?;
     if elapsed < Duration::from_secs(1) || done == 0 {
