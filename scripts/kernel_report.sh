@@ -27,7 +27,9 @@
 #   6. on a CPU with AVX-512 only: both peers limited to AVX2, as on a CPU without AVX-512
 #      (compare4.sh with Embree's `max_isa=avx2` and lucent's `--isa avx2`, then
 #      compare_packets.sh with ISA=avx2, whose anchor is Embree's 8-wide packets). A CPU
-#      without AVX-512 measures that in steps 2 and 3 already.
+#      without AVX-512 measures that in steps 2 and 3 already. (Its runs write the same
+#      per-round files in WORK/<mesh>/ as steps 2 and 3: the raw rounds left are step 6's;
+#      every step's table is in report.md.)
 # Takes about an hour and a quarter on two cores with the defaults; use ROUNDS=1
 # PACKET_ROUNDS=1 BUILD_PAIRS=1 ISA_ROUNDS=1 AVX2_ROUNDS=1 for a quick look.
 set -eu
