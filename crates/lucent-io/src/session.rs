@@ -156,10 +156,8 @@ impl Renderer {
     /// workers.
     pub fn build<R: Send>(&self, work: impl FnOnce() -> R + Send) -> R {
         if self.threads() == 1 {
-            if rayon::current_thread_index().is_some() && rayon::current_num_threads() == 1 {
-                // Already a one-thread pool's thread (this one's, from an earlier build).
-                return work();
-            }
+            // (A later build on this thread finds it in that pool already: `install` runs
+            // the work in place.)
             if let Some(pool) = CALLING_THREAD_POOL.with(|p| p.clone()) {
                 return pool.install(work);
             }
