@@ -5,12 +5,12 @@
 //! glass).
 //!
 //! Eight paths go together, bounce by bounce. Each path's segment is traced one lane at
-//! a time (the BVH), and what it finds is looked at there: a light, or the surface point
-//! of any shape but a flat triangle. Then, for all eight at once: the flat triangles'
-//! surface points, the light sample, the BSDF's value and densities, the MIS weight, the
-//! next direction, the offset origins and the rays' traversal constants. The shadow rays
-//! are traced, and Russian roulette is played, one lane at a time again. A lane whose
-//! path ends takes the batch's next camera sample.
+//! a time (the BVH); then what each found is looked at, lane by lane: a light, or the
+//! surface point of any shape but a flat triangle. Then, for all eight at once: the flat
+//! triangles' surface points, the light sample, the BSDF's value and densities, the MIS
+//! weight, the next direction, the offset origins and the rays' traversal constants. The
+//! shadow rays are traced, and Russian roulette is played, one lane at a time again. A
+//! lane whose path ends takes the batch's next camera sample.
 //!
 //! Every number is the one [`PathTracer::radiance`] computes for that path: the same
 //! operations in the same order, lane by lane (IEEE arithmetic gives the same bits in a
@@ -180,29 +180,35 @@ fn run(
                 next += 1;
             }
         }
-        // Trace, and turn each hit into a vertex to shade (or end the path).
+        // Trace every lane's segment first, then turn each hit into a vertex to shade (or
+        // end the path): the hit primitive, which the search asked the cache for, is read
+        // after the other lanes' searches instead of stalling right after its own.
+        let segments = std::mem::replace(&mut paths.rays, [None; W]);
+        let mut hits = [None; W];
+        for i in 0..W {
+            if segments[i].is_none() {
+                continue;
+            }
+            counts.rays += 1;
+            if k[i] == 1 {
+                hits[i] = camera_hits[sample[i]];
+            } else {
+                scene.closest_hit_into(&paths.bounce.ray.get(i), &mut hits[i]);
+            }
+        }
+        let live = segments.iter().any(Option::is_some);
         let mut shading = [false; W];
         let mut flat = [false; W];
         let mut any = false;
-        let mut live = false;
         for i in 0..W {
-            let Some(ray) = paths.rays[i] else {
+            let Some(ray) = segments[i] else {
                 continue;
             };
-            live = true;
             let first = k[i] == 1;
-            counts.rays += 1;
-            let mut hit = None;
-            if first {
-                hit = camera_hits[sample[i]];
-            } else {
-                scene.closest_hit_into(&paths.bounce.ray.get(i), &mut hit);
-            }
-            paths.rays[i] = None;
             // A segment that escapes finds nothing (no environment here).
             // (By reference: a copy would read the hit back whole just after the search
             // wrote it piece by piece, a stalled store-to-load forward.)
-            let Some(hit) = &hit else {
+            let Some(hit) = &hits[i] else {
                 continue;
             };
             let came = if first {
