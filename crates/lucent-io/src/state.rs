@@ -119,9 +119,9 @@ impl RenderState {
             h.noise_threshold.is_some(),
             "a film whose sampling its header does not describe"
         );
-        out.reserve(f.sums.len() * h.pixel_bytes() + 8);
-        for k in 0..f.sums.len() {
-            for v in f.sums[k].0 {
+        out.reserve(f.counts.len() * h.pixel_bytes() + 8);
+        for k in 0..f.counts.len() {
+            for v in f.sum(k).0 {
                 out.extend(v.to_le_bytes());
             }
             out.extend(f.counts[k].to_le_bytes());
@@ -278,7 +278,7 @@ impl RenderState {
         for (k, px) in body.chunks_exact(size).enumerate() {
             let i = |j: usize| i128::from_le_bytes(px[16 * j..16 * j + 16].try_into().unwrap());
             let u = |at: usize| u32::from_le_bytes(px[at..at + 4].try_into().unwrap());
-            film.sums[k] = ExactSum([i(0), i(1), i(2)]);
+            film.sums_mut()[k] = ExactSum([i(0), i(1), i(2)]);
             film.counts[k] = u(48);
             let mut at = BEAUTY_BYTES;
             if let Some(aovs) = &mut film.aovs {
@@ -440,7 +440,7 @@ pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, St
                 let src = (y * p.width() + x) as usize;
                 let dst = (p.y0 - union.y0 + y) as usize * w + (p.x0 - union.x0 + x) as usize;
                 let aov = s.film.aovs.as_ref().map_or(AovSum::default(), |a| a[src]);
-                film.add(dst, &s.film.sums[src], s.film.counts[src], &aov);
+                film.add(dst, &s.film.sum(src), s.film.counts[src], &aov);
                 if let (Some(to), Some(from)) = (&mut film.noise, &s.film.noise) {
                     to[dst] = from[src];
                 }
@@ -474,7 +474,7 @@ mod tests {
 
     fn state(pixels: PixelRect, samples: Range<u32>) -> RenderState {
         let mut film = Film::new(pixels.width(), pixels.height());
-        for (k, s) in film.sums.iter_mut().enumerate() {
+        for (k, s) in film.sums_mut().iter_mut().enumerate() {
             for i in samples.clone() {
                 s.add_sample(Color::splat((k as f32 + 1.0) * 0.1 + i as f32 * 0.01));
             }

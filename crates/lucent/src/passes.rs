@@ -9,9 +9,11 @@
 //! interval or a minute). Adaptive sampling carries each pixel's estimate from pass to
 //! pass in the film, so its decisions are those of one pass too.
 //!
-//! Without a film to resume, the first pass's film becomes the render's; every later
-//! pass renders into the film of the pass before it (whose samples were added), so that
-//! a picture's worth of fresh memory is faulted in once, not once per pass.
+//! Without a film to resume, the first pass's film becomes the render's, or, since it
+//! keeps one sample per pixel (a quarter of the memory of sums), the second pass's film
+//! takes it in and becomes the render's; every later pass renders into the film of the
+//! pass before it (whose samples were added), so that a picture's worth of fresh memory
+//! is faulted in once or twice, not once per pass.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -73,11 +75,18 @@ pub fn render_in_passes(
         }
         let took = t.elapsed().as_secs_f64();
         // (Exact sums: the first pass's film is what adding it to an empty one gives.)
-        let so_far = match &mut film {
-            Some(so_far) => {
+        let so_far = match film.take() {
+            // The first pass kept one sample per pixel; the second pass's film of sums
+            // takes them in, so that no third film is faulted in.
+            Some(first) if first.holds_one_sample() && !f.holds_one_sample() => {
+                let mut f = f;
+                f.add_earlier(&first);
+                film.insert(f)
+            }
+            Some(mut so_far) => {
                 so_far.add_film(&f);
                 spare = Some(f);
-                so_far
+                film.insert(so_far)
             }
             None => film.insert(f),
         };

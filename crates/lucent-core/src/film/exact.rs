@@ -15,6 +15,9 @@ pub struct ExactSum(pub [i128; 3]);
 /// 2⁶⁴: the fixed point's unit.
 const ONE: f64 = 18_446_744_073_709_551_616.0;
 const LIMIT: f64 = 1_099_511_627_776.0; // 2⁴⁰
+/// The smallest magnitude converted exactly (below it, values are rounded to a multiple
+/// of 2⁻⁶⁴): 2⁻⁴¹.
+const SMALLEST_EXACT: f32 = 1.0 / 2_199_023_255_552.0;
 /// The clamp in the fixed point: 2⁴⁰ · 2⁶⁴.
 const LIMIT_FIXED: i128 = (LIMIT as i128) << 64;
 
@@ -68,6 +71,21 @@ impl ExactSum {
     #[cfg(test)]
     fn fixed_reference(v: f32) -> i128 {
         ((v as f64).clamp(-LIMIT, LIMIT) * ONE).round() as i128
+    }
+
+    /// The f32 whose fixed point is that of `v` and that the sum of `v` alone resolves to
+    /// (`to_f64(fixed(v))` as f32, which is exact): `v` itself where the conversion is
+    /// exact and not clamped, +0 for ±0, the rounded or clamped value elsewhere.
+    #[inline]
+    pub fn canonical(v: f32) -> f32 {
+        let a = v.abs();
+        if (SMALLEST_EXACT..=LIMIT as f32).contains(&a) {
+            v
+        } else if a == 0.0 {
+            0.0
+        } else {
+            Self::to_f64(Self::fixed(v)) as f32
+        }
     }
 
     /// A fixed-point number as f64 (rounded once, to nearest).

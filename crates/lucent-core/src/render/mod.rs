@@ -111,6 +111,9 @@ pub struct RenderControl<'a> {
 struct PixelResult {
     sum: ExactSum,
     taken: u32,
+    /// The last sample (the only one when `taken` is 1: what a film of one sample per
+    /// pixel keeps).
+    last: Color,
 }
 
 /// What a tile's pixels add to the film, row by row: their sums, and only where the job
@@ -190,11 +193,18 @@ pub fn render_after(
     // tile's pixels land does not depend on it.
     let order = shuffled_strata(0x711e, 0, 0, tiles.len() as u32, Vec::new());
     let w = rect.width() as usize;
+    // A pass of one sample per pixel (a ray tracer's whole render, a Monte Carlo render's
+    // first pass) keeps the samples themselves: a quarter of the fresh memory.
+    let one = job.samples.len() == 1;
     let mut film = match spare {
-        Some(mut f) if (f.width, f.height, f.aovs.is_some()) == (rect.width(), rect.height(), job.aovs) => {
+        Some(mut f)
+            if (f.width, f.height, f.aovs.is_some()) == (rect.width(), rect.height(), job.aovs)
+                && (one || !f.holds_one_sample()) =>
+        {
             f.clear();
             f
         }
+        _ if one => Film::one_sample(rect.width(), rect.height(), job.aovs),
         _ => Film::with_aovs(rect.width(), rect.height(), job.aovs),
     };
     if job.noise_threshold.is_some() {
@@ -228,7 +238,8 @@ pub fn render_after(
                     let start = (tile.y0 - rect.y0) as usize * w + row * w + (tile.x0 - rect.x0) as usize;
                     for (i, p) in chunk.iter().enumerate() {
                         let k = row * tw + i;
-                        film.add(start + i, &p.sum, p.taken, pixels.aovs.get(k).unwrap_or(&no_aov));
+                        let aov = pixels.aovs.get(k).unwrap_or(&no_aov);
+                        film.add_pixel(start + i, &p.sum, p.taken, p.last, aov);
                         if let Some(noise) = &mut film.noise {
                             noise[start + i] = pixels.noise[k];
                         }
@@ -316,6 +327,7 @@ fn render_tile(
             pixels.results.push(PixelResult {
                 sum: ExactSum::default(),
                 taken: 0,
+                last: Color::ZERO,
             });
             if adaptive {
                 let (noise, b) = match earlier {
@@ -370,6 +382,7 @@ fn render_tile(
             // The box filter: every sample of the pixel counts the same.
             p.sum.add_sample(c);
             p.taken += 1;
+            p.last = c;
             if let Some(threshold) = job.noise_threshold {
                 let noise = &mut pixels.noise[s.pixel];
                 noise.add(c);
