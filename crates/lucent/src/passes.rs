@@ -77,7 +77,9 @@ pub fn render_in_passes(
         // (Exact sums: the first pass's film is what adding it to an empty one gives.)
         let so_far = match film.take() {
             // The first pass kept one sample per pixel; the second pass's film of sums
-            // takes them in, so that no third film is faulted in.
+            // takes them in and becomes the render's (a two-pass render faults in one
+            // film of sums, not two; a third pass renders into a film of its own, which
+            // later passes use again).
             Some(first) if first.holds_one_sample() && !f.holds_one_sample() => {
                 let mut f = f;
                 f.add_earlier(&first);
