@@ -110,7 +110,7 @@ def main():
     rounds = int(os.environ.get("ROUNDS", "5"))
     threads = int(os.environ.get("THREADS", "1"))
     scale = int(os.environ.get("SCALE", "1"))
-    work = os.environ.get("WORK") or tempfile.mkdtemp(prefix="povray_compare.")
+    work = os.path.abspath(os.environ.get("WORK") or tempfile.mkdtemp(prefix="povray_compare."))
     os.makedirs(work, exist_ok=True)
     ensure_povray()
     version = subprocess.run(["povray", "--version"], capture_output=True, text=True).stderr
