@@ -87,9 +87,10 @@ def run_povray(pov, out, size, threads, work):
     m = re.search(r"Trace Time:.*?\(([0-9.]+) seconds\)", text, re.S)
     rays = re.search(r"Rays:\s+(\d+)", text)
     shadow = re.search(r"Shadow Ray Tests:\s+(\d+)", text)
-    if not (m and rays and shadow):
+    if not (m and rays):
         raise RuntimeError("no statistics from povray:\n" + text[-3000:])
-    return cpu, float(m.group(1)), int(rays.group(1)) + int(shadow.group(1))
+    # (No shadow ray line when the scene has no light.)
+    return cpu, float(m.group(1)), int(rays.group(1)) + (int(shadow.group(1)) if shadow else 0)
 
 
 def summary(values):
@@ -137,16 +138,24 @@ def main():
         tsv = open(os.path.join(work, "rounds.tsv"), "a")
         # lucent works in the scene's folder (its file names are relative to it).
         os.chdir(os.path.dirname(scene))
-        for r in range(rounds):
-            order = ["lucent", "povray"] if r % 2 == 0 else ["povray", "lucent"]
-            for who in order:
-                if who == "lucent":
-                    lu.append(run_lucent(lucent, scene, lu_png, size, threads))
-                else:
-                    po.append(run_povray(pov, pov_png, size, threads, work))
-                got = (lu if who == "lucent" else po)[-1]
-                tsv.write("%s\t%d\t%s\t%.4f\t%.4f\t%d\n" % (name, r, who, got[0], got[1], got[2]))
-        tsv.close()
+        try:
+            for r in range(rounds):
+                order = ["lucent", "povray"] if r % 2 == 0 else ["povray", "lucent"]
+                for who in order:
+                    if who == "lucent":
+                        lu.append(run_lucent(lucent, scene, lu_png, size, threads))
+                    else:
+                        po.append(run_povray(pov, pov_png, size, threads, work))
+                    got = (lu if who == "lucent" else po)[-1]
+                    tsv.write("%s\t%d\t%s\t%.4f\t%.4f\t%d\n" % (name, r, who, got[0], got[1], got[2]))
+        except RuntimeError as e:
+            lines = [l.strip() for l in str(e).splitlines() if l.strip()]
+            why = next((l for l in lines[1:] if "error" in l), lines[-1])
+            print("| %s | failed: %s %s | | | | | |" % (name, lines[0], why))
+            failed = True
+            continue
+        finally:
+            tsv.close()
         diff = subprocess.run([lucent, "diff", lu_png, pov_png], capture_output=True, text=True).stdout
         m = re.search(r"pixels_over=(\d+) pixels=(\d+).*mae=([0-9.]+)", diff)
         pixels = "%s of %s, %s" % (m.group(1), m.group(2), m.group(3)) if m else diff.strip()
