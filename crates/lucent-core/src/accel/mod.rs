@@ -49,6 +49,14 @@ pub trait PrimitiveSet: Sync {
     fn triangle(&self, i: u32) -> Option<[Vec3A; 3]>;
     /// The hit of `ray` with primitive `i` in `(ray.t_min, t_max]`, with `prim = i`.
     fn intersect(&self, i: u32, ray: &PreparedRay, t_max: f32) -> Option<Hit>;
+    /// The world-to-object transform of primitive `i` if it is a sphere (the `sphere`
+    /// command's, an ellipsoid under a non-uniform scale), whose hit is
+    /// [`crate::shape::sphere::intersect_unit_geometric`] in object space: the BVH tests
+    /// such a sphere against all the rays of a packet at once.
+    #[inline(always)]
+    fn sphere(&self, _i: u32) -> Option<&crate::math::Affine3A> {
+        None
+    }
     /// Whether primitive `i` has any hit in `(ray.t_min, t_max]`.
     #[inline(always)]
     fn occludes(&self, i: u32, ray: &PreparedRay, t_max: f32) -> bool {

@@ -225,6 +225,14 @@ impl PrimitiveSet for [Primitive] {
     }
 
     #[inline(always)]
+    fn sphere(&self, i: u32) -> Option<&Affine3A> {
+        match &self[i as usize].shape {
+            Shape::Sphere(s) => Some(&s.world_to_object),
+            _ => None,
+        }
+    }
+
+    #[inline(always)]
     fn intersect(&self, i: u32, ray: &PreparedRay, t_max: f32) -> Option<Hit> {
         self[i as usize].intersect(i, ray, t_max)
     }

@@ -3,7 +3,7 @@
 //! every kind of primitive and on degenerate input.
 
 use super::primitive::{Primitive, Shape};
-use super::test_scenes::{analytic_soup, coplanar_grid, soup, Rng};
+use super::test_scenes::{analytic_soup, coplanar_grid, soup, sphere_soup, Rng};
 use crate::accel::bvh::{Bvh, Isa};
 use crate::accel::list::PrimitiveList;
 use crate::accel::{AccelKind, Accelerator};
@@ -126,6 +126,22 @@ fn coherent_fans_of_rays_match_the_list() {
         rays.extend(fans(&mut rng, 2, 20.0, 18.0));
         let hits = check_against_list(&prims, &rays);
         assert!(hits > 1000 && hits < rays.len() - 500, "{hits} of {}", rays.len());
+    }
+}
+
+#[test]
+fn ellipsoid_soups_match_the_list_single_rays_and_packets() {
+    // Spheres only, so that packets of rays meet leaves of spheres and test each against
+    // all their rays at once; random rays, camera-like fans, and fans of segments that
+    // end among the spheres.
+    for seed in 1..4 {
+        let prims = sphere_soup(seed, 1500);
+        let mut rng = Rng(seed * 13);
+        let mut rays = random_rays(&mut rng, 2000, 15.0, 8.0);
+        rays.extend(fans(&mut rng, 3, 20.0, f32::INFINITY));
+        rays.extend(fans(&mut rng, 2, 20.0, 16.0));
+        let hits = check_against_list(&prims, &rays);
+        assert!(hits > 2000 && hits < rays.len() - 500, "{hits} of {}", rays.len());
     }
 }
 

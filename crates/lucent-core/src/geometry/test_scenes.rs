@@ -26,6 +26,20 @@ pub fn soup(seed: u64, n: usize) -> Vec<Primitive> {
         .collect()
 }
 
+/// Spheres and ellipsoids alone (rotated, scaled, overlapping), so that the BVH's leaves
+/// hold several and the packets' sphere-against-all-rays test runs on most of the rays.
+pub fn sphere_soup(seed: u64, n: usize) -> Vec<Primitive> {
+    let mut rng = Rng(seed);
+    (0..n)
+        .map(|_| {
+            let m = Affine3A::from_translation(rng.vec(10.0).into())
+                * Affine3A::from_axis_angle(rng.vec(1.0).normalize_or(Vec3A::X).into(), rng.range(0.0, 6.3))
+                * Affine3A::from_scale(Vec3::new(rng.range(0.1, 1.5), rng.range(0.1, 1.5), rng.range(0.1, 1.5)));
+            Primitive::new(Shape::Sphere(Box::new(Sphere::new(m))), 0)
+        })
+        .collect()
+}
+
 /// Boxes, cylinders, disks, cones and quadrics under random affine transforms, and a
 /// few unbounded planes (which every structure leaves to the scene).
 pub fn analytic_soup(seed: u64, n: usize) -> Vec<Primitive> {

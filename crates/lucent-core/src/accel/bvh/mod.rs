@@ -26,6 +26,7 @@ mod packet_rays;
 mod query;
 mod ray_lanes;
 pub mod ray_packet;
+mod ray_sphere;
 mod ray_triangle;
 mod sah_bins;
 mod traverse;

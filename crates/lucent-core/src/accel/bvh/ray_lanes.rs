@@ -26,6 +26,8 @@ pub trait RayLanes: Copy {
     unsafe fn sub(self, o: Self) -> Self;
     unsafe fn mul(self, o: Self) -> Self;
     unsafe fn div(self, o: Self) -> Self;
+    /// The correctly rounded square root (only the sphere test uses it).
+    unsafe fn sqrt(self) -> Self;
     /// `self · b − c` with one rounding (fused; only the box test uses it).
     unsafe fn mul_sub(self, b: Self, c: Self) -> Self;
     /// `self < o ? self : o` (`o` when either is NaN, as `minps`).
@@ -101,6 +103,10 @@ mod x86 {
             Rays8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0))
         }
         binary_ops!(Rays8: add _mm256_add_ps, sub _mm256_sub_ps, mul _mm256_mul_ps, div _mm256_div_ps, min _mm256_min_ps, max _mm256_max_ps);
+        #[inline(always)]
+        unsafe fn sqrt(self) -> Self {
+            Rays8(_mm256_sqrt_ps(self.0))
+        }
         #[inline(always)]
         unsafe fn mul_sub(self, b: Self, c: Self) -> Self {
             Rays8(_mm256_fmsub_ps(self.0, b.0, c.0))
@@ -189,6 +195,10 @@ mod x86 {
             Rays16(_mm512_abs_ps(self.0))
         }
         binary_ops!(Rays16: add _mm512_add_ps, sub _mm512_sub_ps, mul _mm512_mul_ps, div _mm512_div_ps, min _mm512_min_ps, max _mm512_max_ps);
+        #[inline(always)]
+        unsafe fn sqrt(self) -> Self {
+            Rays16(_mm512_sqrt_ps(self.0))
+        }
         #[inline(always)]
         unsafe fn mul_sub(self, b: Self, c: Self) -> Self {
             Rays16(_mm512_fmsub_ps(self.0, b.0, c.0))

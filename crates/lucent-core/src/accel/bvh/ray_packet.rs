@@ -7,7 +7,9 @@
 //! is tested against every active ray of the packet; a child that some ray enters is
 //! pushed with the mask of those rays. At a leaf reached by several rays that share
 //! their dominant axis, each triangle is tested against all of them at once
-//! ([`super::ray_triangle`]); otherwise each ray runs the single-ray four-triangle test.
+//! ([`super::ray_triangle`]), and so is each sphere ([`super::ray_sphere`], the scalar
+//! sphere test's bits in every lane); otherwise each ray runs the single-ray
+//! four-triangle test.
 //! A node is fetched once for the whole packet (its cache lines asked for when it is
 //! pushed), and the lanes' independent work fills the pipeline that one ray's chain of
 //! dependent loads leaves idle. The rays' lanes, and the test of one child box against
@@ -31,6 +33,7 @@
 use super::packet::{LaneKind, Lanes as Bits, Packet};
 use super::packet_rays::packet_lanes;
 use super::ray_lanes::RayLanes;
+use super::ray_sphere::SphereRays;
 use super::ray_triangle::{self, ShearedRays};
 use super::traverse::leaf_packets;
 use super::wide::{WideNode, EMPTY, LEAF, WIDTH};
@@ -403,6 +406,7 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
     t_max_lanes: &mut L,
 ) -> u32 {
     let mut t_max = [0f32; MAX_PACKET];
+    let mut sphere_rays: Option<SphereRays<L>> = None;
     let mut active = mask;
     let mut finished = 0;
     let (mut t, mut v, mut w, mut inv_det) = (
@@ -417,9 +421,31 @@ unsafe fn leaf_by_lanes<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             let (changed, accepted, lane_t) = match packet.lane_kind(lane) {
                 LaneKind::Unused => break,
                 LaneKind::Other(id) => {
-                    for i in Bits(active) {
-                        if Q::other(&mut states[i], prims, prepared.get(i), id) {
-                            finished |= 1 << i;
+                    match prims.sphere(id) {
+                        // A sphere against all the rays at once (the rays' fields gathered
+                        // once per leaf): each root is its ray's scalar answer.
+                        Some(m) if active.count_ones() >= 2 => {
+                            for i in Bits(active) {
+                                t_max[i] = Q::t_max(&states[i]);
+                            }
+                            if sphere_rays.is_none() {
+                                sphere_rays = Some(SphereRays::gather(prepared.rays));
+                            }
+                            // (Set just above.)
+                            let rays = sphere_rays.as_ref().unwrap_unchecked();
+                            rays.roots(m, L::load(t_max.as_ptr())).store(t.as_mut_ptr());
+                            for i in Bits(active) {
+                                if !t[i].is_nan() && Q::record(&mut states[i], Hit::new(t[i], id, 0.0, 0.0)) {
+                                    finished |= 1 << i;
+                                }
+                            }
+                        }
+                        _ => {
+                            for i in Bits(active) {
+                                if Q::other(&mut states[i], prims, prepared.get(i), id) {
+                                    finished |= 1 << i;
+                                }
+                            }
                         }
                     }
                     (active, 0, *t_max_lanes)
