@@ -1,12 +1,15 @@
 //! One `f32` per ray of a packet, side by side: eight lanes with AVX2, sixteen with
 //! AVX-512 (F, VL, BW). The packet traversal of [`super::ray_packet`] and the packet
-//! triangle test of [`super::ray_triangle`] are written once over this trait.
+//! triangle and sphere tests of [`super::ray_triangle`] and [`super::ray_sphere`] are
+//! written once over this trait.
 //!
 //! Comparisons return plain bit masks (bit `i` for lane `i`): AVX-512 produces them
 //! directly in mask registers, AVX2 through `movemask`. Every operation is the single
 //! IEEE instruction it names, and only the box test uses the fused multiply–subtract, so
-//! the triangle test's lanes compute exactly what the scalar code computes for its ray. The implementations are `#[inline(always)]`
-//! and only take effect inside functions compiled for their instruction set.
+//! the triangle and sphere tests' lanes compute exactly what the scalar code computes for
+//! its ray. The implementations are `#[inline(always)]` and only take effect inside
+//! functions compiled for their instruction set (not inside a closure there, which is a
+//! function of its own).
 
 /// A vector of one `f32` per ray.
 pub trait RayLanes: Copy {
