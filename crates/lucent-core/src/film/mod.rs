@@ -143,17 +143,20 @@ impl Film {
     #[inline]
     pub fn add(&mut self, index: usize, sum: &ExactSum, count: u32, aov: &AovSum) {
         if let Pixels::Samples(samples) = &mut self.pixels {
-            let sample: Color = sum.value().as_vec3().into();
             let fits = match count {
                 0 => *sum == ExactSum::default(),
-                1 => self.counts[index] == 0 && one_sum(sample) == *sum,
+                // (The conversion only where a sample is kept.)
+                1 if self.counts[index] == 0 => {
+                    let sample: Color = sum.value().as_vec3().into();
+                    let kept = one_sum(sample) == *sum;
+                    if kept {
+                        samples[index] = sample;
+                    }
+                    kept
+                }
                 _ => false,
             };
-            if fits {
-                if count == 1 {
-                    samples[index] = sample;
-                }
-            } else {
+            if !fits {
                 // More than one sample after all (or a sum that is not one sample's):
                 // sums from here on.
                 self.make_sums();
