@@ -195,8 +195,15 @@ fn random_scenes_render_quickly_and_never_panic() {
             let built = session.built.as_ref().unwrap();
             let job = built.job().probe(2, 4);
             let samples = job.pixels.pixels() as f64 * job.samples.len() as f64;
-            if built.work.rays_per_pixel / built.settings.spp as f64 * samples <= 200_000.0 {
-                renderer.render(built, &job, &|_| {}, &cancel).unwrap();
+            let most = built.work.most_rays_per_pixel / built.settings.spp as f64 * samples;
+            if most <= 200_000.0 {
+                let (_, stats) = renderer.render(built, &job, &|_| {}, &cancel).unwrap();
+                // The estimate's bound holds.
+                assert!(
+                    stats.rays as f64 <= most,
+                    "case {case}: {} rays > {most}:\n{text}",
+                    stats.rays
+                );
                 rendered += 1;
             }
         }
@@ -205,4 +212,72 @@ fn random_scenes_render_quickly_and_never_panic() {
         assert!(took < Duration::from_secs(2), "case {case} took {took:?}:\n{text}");
     }
     assert!(rendered > 100, "only {rendered} scenes got as far as rendering");
+}
+
+/// Builds `text` (with the list, as the fuzzers do) and renders `side` × `side` pixels at
+/// its centre, up to four samples each: the render's statistics, the bound on its rays
+/// from the work estimate, and the warnings.
+fn rays_and_bound(text: &str, side: u32) -> (lucent_core::render::RenderStats, f64, String) {
+    use lucent_core::accel::AccelKind;
+    use lucent_io::session::Renderer;
+    let options = SessionOptions {
+        strict: true,
+        accel: AccelKind::List,
+        memory_limit: 64 << 20,
+    };
+    let mut session = Session::parse_text("tree.test", text.as_bytes(), options);
+    assert!(session.build(), "{}", session.diags.render(&session.desc.sources));
+    let built = session.built.as_ref().unwrap();
+    let job = built.job().probe(side, 4);
+    let samples = job.pixels.pixels() as f64 * job.samples.len() as f64;
+    let most = built.work.most_rays_per_pixel / built.settings.spp as f64 * samples;
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let (_, stats) = Renderer::new(Some(1))
+        .unwrap()
+        .render(built, &job, &|_| {}, &cancel)
+        .unwrap();
+    (stats, most, session.diags.render(&session.desc.sources))
+}
+
+/// Glass splits every ray in two: between facing glass planes and inside a mirror box the
+/// ray trees of the Whitted tracer grow with the depth — geometrically where a material
+/// reflects more than it receives. Each render traces no more rays than the work
+/// estimate's bound says (which `lucent check`, the warning about absurd work and the
+/// fuzzers rely on), and no camera sample more than `MAX_TREE_RAYS` of its tree.
+#[test]
+fn ray_trees_stay_within_the_work_bound_and_the_cap() {
+    use lucent_core::integrator::whitted::MAX_TREE_RAYS;
+    let planes = "camera 0 0 0.5  0.3 0.1 -1  0 1 0  60\nplane 0 0 -1 0 0 1\nplane 0 0 1 0 0 -1\n";
+    let box_and_sphere = "camera 0 0 0.9  0 0 0  0 1 0  60\nbox -1 -1 -1 1 1 1\nsphere 0 0 0 0.5\n";
+    for depth in [1, 2, 5, 9, 12] {
+        for (specular, glossy) in [
+            ("1 1 1", ""),
+            ("0.9 0.5 0.2", "glossy 50 4\n"),
+            ("0 0 30", ""),
+            ("2 2 2", "glossy 20 3\n"),
+        ] {
+            for (geometry, light) in [(planes, ""), (box_and_sphere, "point 0 0.5 0.5 1 1 1\n")] {
+                let text = format!(
+                    "size 8 8\nmaxdepth {depth}\n{light}specular {specular}\n{glossy}transparent 1 1 1\nior 1.5\n{geometry}"
+                );
+                let (stats, most, _) = rays_and_bound(&text, 2);
+                assert!(stats.rays as f64 <= most, "{} rays > {most}:\n{text}", stats.rays);
+                assert_eq!(stats.cut_branches, 0, "{text}");
+            }
+        }
+    }
+    // The fuzzer's hang: 2^5001 rays asked for (glass in a mirror box, both gaining
+    // weight in blue). One sample traces its tree's first
+    // MAX_TREE_RAYS rays, then cuts the rest, and says so before it starts.
+    let text = "size 1 1\nmaxdepth 5001\ncamera 0 0 0.9  0 0 0  0 1 0  60\nspecular 0 0 30\nbox -1 -1 -1 1 1 1\ntransparent 1 1 1\nior 1.5\nsphere 0 0 0 0.5\n";
+    let (stats, most, warnings) = rays_and_bound(text, 1);
+    assert_eq!(most, MAX_TREE_RAYS as f64);
+    assert_eq!(stats.rays, MAX_TREE_RAYS as u64);
+    assert!(stats.cut_branches > 0);
+    assert!(
+        warnings.contains(
+            "maxdepth: glass splits every ray it meets in two, so one camera sample may trace more than 1048576 rays"
+        ),
+        "{warnings}"
+    );
 }

@@ -121,8 +121,8 @@ pub fn run(args: &CheckArgs) -> u8 {
     );
     let w = &built.work;
     println!(
-        "work:       about {:.1e} rays ({:.0} per pixel), reflections up to depth {}",
-        w.rays, w.rays_per_pixel, w.depth
+        "work:       about {:.1e} rays ({:.0} per pixel, at most {:.0}), reflections up to depth {}",
+        w.rays, w.rays_per_pixel, w.most_rays_per_pixel, w.depth
     );
     println!(
         "textures:   {}{}",

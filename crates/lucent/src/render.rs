@@ -11,7 +11,7 @@ use std::time::Instant;
 use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_core::film::Film;
-use lucent_core::integrator::whitted::MAX_PENDING;
+use lucent_core::integrator::whitted::{MAX_PENDING, MAX_TREE_RAYS};
 use lucent_core::integrator::PixelSampling;
 use lucent_core::math::Color;
 use lucent_core::render::job::RenderJob;
@@ -520,9 +520,8 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     if stats.cut_branches > 0 {
         extra_warnings += 1;
         eprintln!(
-            "lucent: warning: {} ray branches were not traced: too many were waiting at once (mirrors and glass that reflect everything, and a maxdepth above {})",
+            "lucent: warning: {} ray branches were not traced: a camera sample's ray tree passed {MAX_TREE_RAYS} rays, or more than {MAX_PENDING} branches were waiting at once (glass, and mirrors that reflect everything, with a large maxdepth)",
             stats.cut_branches,
-            MAX_PENDING / 2
         );
     }
     // Everything the build read (MTL libraries and their images too) is an input.

@@ -64,21 +64,7 @@ impl DepthControl {
     /// The control for `scene` whose image is encoded with `gamma`.
     pub fn for_scene(scene: &Scene, gamma: f32) -> DepthControl {
         let radiance = scene_radiance(scene);
-        // Materials share a handful of indices of refraction: each is weighed once.
-        let mut fresnel: Vec<(f32, f32)> = Vec::new();
-        let mut min_fresnel_of = |ior: f32| match fresnel.iter().find(|(n, _)| *n == ior) {
-            Some(&(_, f)) => f,
-            None => {
-                let f = min_fresnel(ior);
-                fresnel.push((ior, f));
-                f
-            }
-        };
-        let reflectance = scene
-            .materials
-            .iter()
-            .map(|m| bounce_factor(m, &mut min_fresnel_of))
-            .fold(0.0f32, f32::max);
+        let reflectance = largest_bounce_factor(&scene.materials);
         let draws = scene.lights.iter().any(|l| matches!(l, Light::Quad(_)))
             || scene.materials.iter().any(|m| m.glossy.is_some());
         DepthControl {
@@ -136,6 +122,26 @@ impl DepthControl {
         let d = ((self.budget / self.bound).ln() / self.reflectance.ln()).ceil();
         Some(d.clamp(0.0, u32::MAX as f32) as u32)
     }
+}
+
+/// `ρ`: the largest factor a bounce off any of `materials` multiplies a weight by (see
+/// [`bounce_factor`]); infinite where a material's factor is not a number.
+pub fn largest_bounce_factor(materials: &[Material]) -> f32 {
+    // Materials share a handful of indices of refraction: each is weighed once.
+    let mut fresnel: Vec<(f32, f32)> = Vec::new();
+    let mut min_fresnel_of = |ior: f32| match fresnel.iter().find(|(n, _)| *n == ior) {
+        Some(&(_, f)) => f,
+        None => {
+            let f = min_fresnel(ior);
+            fresnel.push((ior, f));
+            f
+        }
+    };
+    materials
+        .iter()
+        .map(|m| bounce_factor(m, &mut min_fresnel_of))
+        .map(|f| if f.is_nan() { f32::INFINITY } else { f })
+        .fold(0.0f32, f32::max)
 }
 
 /// The largest factor a bounce off material `m` multiplies a weight by, summed over the

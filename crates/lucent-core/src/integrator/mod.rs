@@ -23,7 +23,8 @@ use crate::scene::Scene;
 pub struct TraceCounts {
     /// Every ray traced: camera, shadow, reflected and refracted rays.
     pub rays: u64,
-    /// Branches of ray trees not traced because too many were waiting at once.
+    /// Branches of ray trees not traced: past a sample's [`whitted::MAX_TREE_RAYS`], or
+    /// because too many were waiting at once ([`whitted::MAX_PENDING`]).
     pub cut_branches: u64,
 }
 

@@ -44,8 +44,9 @@ pub struct RenderStats {
     pub bad_samples: u64,
     /// The first pixels (in reading order, `(x, y)`) where that happened, up to four.
     pub bad_pixels: BadPixels,
-    /// Branches of ray trees cut because too many were waiting at once
-    /// ([`crate::integrator::whitted::MAX_PENDING`]).
+    /// Branches of ray trees cut: past a camera sample's
+    /// [`crate::integrator::whitted::MAX_TREE_RAYS`] rays, or because too many were
+    /// waiting at once ([`crate::integrator::whitted::MAX_PENDING`]).
     pub cut_branches: u64,
     /// Samples taken in all, and the fewest and most that one pixel took (they differ
     /// with adaptive sampling).

@@ -8,7 +8,7 @@ use lucent_core::integrator::analytic_direct::AnalyticDirect;
 use lucent_core::integrator::depth::DepthControl;
 use lucent_core::integrator::direct::Direct;
 use lucent_core::integrator::path::{self, Nee, PathTracer, UNBOUNDED_SAFETY_CAP};
-use lucent_core::integrator::whitted::Whitted;
+use lucent_core::integrator::whitted::{Whitted, MAX_TREE_RAYS};
 use lucent_core::integrator::Integrator;
 use lucent_core::math::Color;
 use lucent_core::scene::Scene;
@@ -84,6 +84,7 @@ pub fn integrator(desc: &SceneDesc, diags: &mut Diagnostics) -> Chosen {
             light_samples,
             light_stratify,
             depth: DepthControl::off(),
+            max_tree_rays: MAX_TREE_RAYS,
         }),
         IntegratorKind::AnalyticDirect => Chosen::AnalyticDirect(AnalyticDirect),
         IntegratorKind::Direct => Chosen::Direct(Direct {
@@ -118,13 +119,16 @@ pub fn control_depth(chosen: &mut Chosen, scene: &Scene, gamma: f32) {
     }
 }
 
-/// A render's work: the rays it traces, about.
+/// A render's work: the rays it traces, about, and at most.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Work {
     /// Rays per pixel: camera rays, shadow rays, reflected and refracted rays.
     pub rays_per_pixel: f64,
     /// For the whole image.
     pub rays: f64,
+    /// Rays per pixel at most, whatever the scene's surfaces do to the rays: every glass
+    /// hit splitting in two, every path going to its last bounce.
+    pub most_rays_per_pixel: f64,
     /// The deepest bounce traced: `maxdepth`, or less where adaptive depth control stops
     /// the branches first.
     pub depth: u32,
@@ -179,34 +183,72 @@ pub fn warn_if_dark(desc: &SceneDesc, scene: &Scene, diags: &mut Diagnostics) {
 /// setting responsible when it is absurd.
 pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u64, diags: &mut Diagnostics) -> Work {
     let spp = desc.spp() as f64;
-    // (rays per sample, shadow rays per shading point, the deepest bounce)
-    let (per_sample, shadow, depth) = match chosen {
+    let bounded = |depth: u32| depth as f64 + 1.0;
+    // (rays per sample, at most, shadow rays per shading point, the deepest bounce)
+    let (per_sample, most, shadow, depth) = match chosen {
         Chosen::Whitted(w) => whitted_rays(scene, w),
-        Chosen::AnalyticDirect(_) => (1.0, 0.0, 1),
+        Chosen::AnalyticDirect(_) => (1.0, 1.0, 0.0, 1),
         Chosen::Direct(d) => {
             let shadow = shadow_rays(scene, d.light_samples);
-            (1.0 + shadow, shadow, 1)
+            // Through up to `maxdepth` mirrors and glass, then the lights' shadow rays.
+            let most = bounded(d.max_delta_bounces) + sampled_shadow_rays(scene, d.light_samples);
+            (1.0 + shadow, most, shadow, 1)
         }
         Chosen::PathTracer(p) => {
             // A path's segments (about the depth, or a few with Russian roulette) each
             // with their shadow rays.
             let segments = p.max_depth.map_or(8.0, |d| d as f64 + 1.0);
-            let shadow = match p.nee {
-                Nee::Off => 0.0,
-                Nee::On => shadow_rays(scene, p.light_samples),
-                Nee::Mis => 1.0,
+            let (shadow, most_shadow) = match p.nee {
+                Nee::Off => (0.0, 0.0),
+                Nee::On => (
+                    shadow_rays(scene, p.light_samples),
+                    sampled_shadow_rays(scene, p.light_samples),
+                ),
+                Nee::Mis => (1.0, 1.0),
             };
             let depth = p.max_depth.unwrap_or(UNBOUNDED_SAFETY_CAP);
-            (segments * (1.0 + shadow), shadow, depth)
+            (
+                segments * (1.0 + shadow),
+                bounded(depth) * (1.0 + most_shadow),
+                shadow,
+                depth,
+            )
         }
     };
+    // The typical count never passes the bound (the tree's cap, chiefly).
+    let per_sample = per_sample.min(most);
     let work = Work {
         rays_per_pixel: spp * per_sample,
         rays: spp * per_sample * pixels as f64,
+        most_rays_per_pixel: spp * most,
         depth,
     };
     warn_if_absurd(desc, &work, spp, shadow, depth, diags);
+    if let Chosen::Whitted(w) = chosen {
+        warn_if_cut(desc, scene, w, diags);
+    }
     work
+}
+
+/// Warns at `maxdepth` when a camera sample's ray tree could pass
+/// [`Whitted::max_tree_rays`], where the renderer cuts it.
+fn warn_if_cut(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, diags: &mut Diagnostics) {
+    if whitted.tree_rays_bound(&scene.materials) < whitted.max_tree_rays as f64 {
+        return;
+    }
+    let loc = desc.max_depth.as_ref().map(|d| d.loc).unwrap_or(desc.end);
+    let why = if scene.materials.iter().any(|m| m.transparent != Color::ZERO) {
+        "glass splits every ray it meets in two, so "
+    } else {
+        ""
+    };
+    diags.warning(
+        loc,
+        format!(
+            "maxdepth: {why}one camera sample may trace more than {} rays; the branches of its ray tree past them are not traced",
+            whitted.max_tree_rays
+        ),
+    );
 }
 
 /// Shadow rays per shading point: `samples` per area light, one per delta light.
@@ -218,9 +260,23 @@ fn shadow_rays(scene: &Scene, samples: u32) -> f64 {
         .sum()
 }
 
-/// Rays per sample, shadow rays per shading point and the deepest bounce of the
-/// Whitted ray tracer.
-fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, u32) {
+/// Shadow rays per shading point of the Monte Carlo integrators, which sample every
+/// light of [`Scene::sampled_light`] (the emissive surfaces and the environment too).
+fn sampled_shadow_rays(scene: &Scene, samples: u32) -> f64 {
+    (0..scene.sampled_light_count())
+        .map(|i| {
+            if scene.sampled_light(i).is_delta() {
+                1.0
+            } else {
+                samples.max(1) as f64
+            }
+        })
+        .sum()
+}
+
+/// Rays per sample (about, and at most), shadow rays per shading point and the deepest
+/// bounce of the Whitted ray tracer.
+fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, f64, u32) {
     let m = &scene.materials;
     let reflects = m
         .iter()
@@ -243,7 +299,11 @@ fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, u32) {
     // Every hit casts its shadow rays; the first bounce fans out into the glossy rays,
     // later ones follow one ray each; glass splits a path in two.
     let per_sample = (1.0 + shadow) * (1.0 + glossy * depth as f64) * split;
-    (per_sample, shadow, depth)
+    // Every ray of the tree casts at most a shadow ray per light (`lightsamples` per
+    // quad light).
+    let most_shadow = shadow_rays(scene, whitted.light_samples.max(1));
+    let most = (1.0 + most_shadow) * whitted.tree_rays_bound(m);
+    (per_sample, most, shadow, depth)
 }
 
 fn warn_if_absurd(desc: &SceneDesc, work: &Work, spp: f64, shadow: f64, depth: u32, diags: &mut Diagnostics) {

@@ -64,6 +64,7 @@ impl Whitted {
                     sampler: &mut samplers[k],
                     counts,
                     dropped: 0.0,
+                    traced: 0,
                 };
                 // Samples that meet nothing, or whose tree is left out at once, go alone.
                 let hit = match hit {
@@ -74,6 +75,7 @@ impl Whitted {
                     }
                 };
                 t.counts.rays += 1;
+                t.traced += 1;
                 let before = deferred.len();
                 let sp = self.shade(&mut t, ray, hit, deferred);
                 shaded.push(Shaded {
@@ -95,6 +97,7 @@ impl Whitted {
                     sampler: &mut samplers[k],
                     counts,
                     dropped: s.dropped,
+                    traced: 1,
                 };
                 let mut total = BACKGROUND;
                 total += Color::ONE * deferred.sum(s.first, s.terms);

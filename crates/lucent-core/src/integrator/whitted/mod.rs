@@ -33,7 +33,8 @@
 //!
 //! The ray tree is walked with an explicit stack, in the order of the recursion it
 //! stands for, so that no scene can overflow the thread's stack; a branch whose weight
-//! can no longer show is not traced (adaptive depth control, [`super::depth`]).
+//! can no longer show is not traced (adaptive depth control, [`super::depth`]), and one
+//! camera sample traces at most [`MAX_TREE_RAYS`] rays of its tree ([`tree_size`]).
 //!
 //! The renderer hands the ray tracer 64 camera samples at a time: their first hits'
 //! shadow rays toward point and directional lights are traced together
@@ -41,6 +42,7 @@
 
 mod camera_batch;
 mod light_terms;
+mod tree_size;
 
 use super::depth::DepthControl;
 use super::shadow_batch::ShadowBatch;
@@ -55,6 +57,7 @@ use crate::scene::Scene;
 use crate::shading::optics::{fresnel_dielectric, lift_above, phong_lobe, reflect_above, refract, side_of};
 use crate::shading::surface;
 use light_terms::{Immediate, LightTerms};
+pub use tree_size::MAX_TREE_RAYS;
 
 /// Branches of the ray tree whose weight falls below this add less than a tenth of an
 /// 8-bit step: they are not traced.
@@ -69,6 +72,8 @@ struct Tracing<'a> {
     counts: &'a mut TraceCounts,
     /// What left-out branches could have added (adaptive depth control's spending).
     dropped: f32,
+    /// The rays of the tree traced so far (shadow rays not counted).
+    traced: u32,
 }
 
 /// Branches of one ray tree waiting to be traced, at most this many at once (4 MB a
@@ -111,6 +116,9 @@ pub struct Whitted {
     pub light_stratify: bool,
     /// When a branch's weight can no longer show ([`DepthControl::for_scene`]).
     pub depth: DepthControl,
+    /// The rays one camera sample's tree may trace ([`MAX_TREE_RAYS`]); the branches
+    /// past them are cut and counted.
+    pub max_tree_rays: u32,
 }
 
 impl Whitted {
@@ -207,6 +215,11 @@ impl Whitted {
             if self.leave_out(t, weight, pending) {
                 return;
             }
+            if t.traced >= self.max_tree_rays {
+                t.counts.cut_branches += 1;
+                return;
+            }
+            t.traced += 1;
             let mut found = None;
             t.camera.take_into(scene, &ray, t.counts, &mut found);
             let Some(hit) = &found else {
@@ -406,6 +419,7 @@ impl Integrator for Whitted {
             sampler,
             counts,
             dropped: 0.0,
+            traced: 0,
         };
         // Only a tree that branches allocates.
         let mut pending = Vec::new();
