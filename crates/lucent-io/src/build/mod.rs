@@ -17,6 +17,7 @@ mod lights;
 mod materials;
 mod settings;
 mod tessellation;
+mod work;
 
 use lucent_core::accel::AccelKind;
 use lucent_core::camera::Resolution;
@@ -29,7 +30,8 @@ use crate::desc::{IntegratorKind, SampleSource, SceneDesc};
 use crate::diag::Diagnostics;
 use crate::resources::Resources;
 
-pub use settings::{Work, UNBOUNDED_DEPTH_CAP};
+pub use settings::UNBOUNDED_DEPTH_CAP;
+pub use work::Work;
 
 #[derive(Clone, Copy, Debug)]
 pub struct BuildOptions {
@@ -62,7 +64,7 @@ pub struct Built {
     pub integrator: Box<dyn Integrator>,
     pub settings: RenderSettings,
     /// What rendering the whole image costs, about.
-    pub work: settings::Work,
+    pub work: work::Work,
 }
 
 impl Built {
@@ -132,7 +134,7 @@ fn build_parts(
     let scene = Scene::new(parts, options.accel);
     settings::control_depth(&mut integrator, &scene, desc.gamma() as f32);
     settings::warn_if_dark(desc, &scene, diags);
-    let work = settings::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
+    let work = work::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
     Some(Built {
         scene,
         integrator: integrator.into_box(),

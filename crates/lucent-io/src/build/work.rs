@@ -1,0 +1,197 @@
+//! The work a render of the scene asks for: the rays it traces, about and at most, and
+//! the warnings when that is more than any picture needs (the settings that ask for
+//! it: `spp`, `lightsamples`, `maxdepth`, `size`).
+
+use lucent_core::integrator::path::{Nee, UNBOUNDED_SAFETY_CAP};
+use lucent_core::integrator::whitted::Whitted;
+use lucent_core::math::Color;
+use lucent_core::scene::Scene;
+
+use super::settings::Chosen;
+use crate::desc::SceneDesc;
+use crate::diag::{Diagnostics, Loc};
+
+/// A render's work: the rays it traces, about, and at most.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Work {
+    /// Rays per pixel: camera rays, shadow rays, reflected and refracted rays.
+    pub rays_per_pixel: f64,
+    /// For the whole image.
+    pub rays: f64,
+    /// Rays per pixel at most, whatever the scene's surfaces do to the rays: every glass
+    /// hit splitting in two, every path going to its last bounce.
+    pub most_rays_per_pixel: f64,
+    /// The deepest bounce traced: `maxdepth`, or less where adaptive depth control stops
+    /// the branches first.
+    pub depth: u32,
+}
+
+/// Work beyond either is reported: hours of rays (about 3 hours at 1 Mray/s per core on
+/// two cores), or more rays for one pixel than any picture needs.
+pub const ABSURD_RAYS: f64 = 1e10;
+pub const ABSURD_RAYS_PER_PIXEL: f64 = (1u64 << 20) as f64;
+
+/// Estimates the work of rendering the whole image (`pixels` of them), and warns at the
+/// setting responsible when it is absurd.
+pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u64, diags: &mut Diagnostics) -> Work {
+    let spp = desc.spp() as f64;
+    let bounded = |depth: u32| depth as f64 + 1.0;
+    // (rays per sample, at most, shadow rays per shading point, the deepest bounce)
+    let (per_sample, most, shadow, depth) = match chosen {
+        Chosen::Whitted(w) => whitted_rays(scene, w),
+        Chosen::AnalyticDirect(_) => (1.0, 1.0, 0.0, 1),
+        Chosen::Direct(d) => {
+            let shadow = shadow_rays(scene, d.light_samples);
+            // Through up to `maxdepth` mirrors and glass, then the lights' shadow rays.
+            let most = bounded(d.max_delta_bounces) + sampled_shadow_rays(scene, d.light_samples);
+            (1.0 + shadow, most, shadow, 1)
+        }
+        Chosen::PathTracer(p) => {
+            // A path's segments (about the depth, or a few with Russian roulette) each
+            // with their shadow rays.
+            let segments = p.max_depth.map_or(8.0, |d| d as f64 + 1.0);
+            let (shadow, most_shadow) = match p.nee {
+                Nee::Off => (0.0, 0.0),
+                Nee::On => (
+                    shadow_rays(scene, p.light_samples),
+                    sampled_shadow_rays(scene, p.light_samples),
+                ),
+                Nee::Mis => (1.0, 1.0),
+            };
+            let depth = p.max_depth.unwrap_or(UNBOUNDED_SAFETY_CAP);
+            (
+                segments * (1.0 + shadow),
+                bounded(depth) * (1.0 + most_shadow),
+                shadow,
+                depth,
+            )
+        }
+    };
+    // The typical count never passes the bound (the tree's cap, chiefly).
+    let per_sample = per_sample.min(most);
+    let work = Work {
+        rays_per_pixel: spp * per_sample,
+        rays: spp * per_sample * pixels as f64,
+        most_rays_per_pixel: spp * most,
+        depth,
+    };
+    warn_if_absurd(desc, &work, spp, shadow, depth, diags);
+    if let Chosen::Whitted(w) = chosen {
+        warn_if_cut(desc, scene, w, diags);
+    }
+    work
+}
+
+/// Warns at `maxdepth` when a camera sample's ray tree could pass
+/// [`Whitted::max_tree_rays`], where the renderer cuts it.
+fn warn_if_cut(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, diags: &mut Diagnostics) {
+    if whitted.tree_rays_bound(&scene.materials) < whitted.max_tree_rays as f64 {
+        return;
+    }
+    let loc = desc.max_depth.as_ref().map(|d| d.loc).unwrap_or(desc.end);
+    let why = if scene.materials.iter().any(|m| m.transparent != Color::ZERO) {
+        "glass splits every ray it meets in two, so "
+    } else {
+        ""
+    };
+    diags.warning(
+        loc,
+        format!(
+            "maxdepth: {why}one camera sample may trace more than {} rays; the branches of its ray tree past them are not traced",
+            whitted.max_tree_rays
+        ),
+    );
+}
+
+/// Shadow rays per shading point: `samples` per area light, one per delta light.
+fn shadow_rays(scene: &Scene, samples: u32) -> f64 {
+    scene
+        .lights
+        .iter()
+        .map(|l| if l.is_delta() { 1.0 } else { samples as f64 })
+        .sum()
+}
+
+/// Shadow rays per shading point of the Monte Carlo integrators, which sample every
+/// light of [`Scene::sampled_light`] (the emissive surfaces and the environment too).
+fn sampled_shadow_rays(scene: &Scene, samples: u32) -> f64 {
+    (0..scene.sampled_light_count())
+        .map(|i| {
+            if scene.sampled_light(i).is_delta() {
+                1.0
+            } else {
+                samples.max(1) as f64
+            }
+        })
+        .sum()
+}
+
+/// Rays per sample (about, and at most), shadow rays per shading point and the deepest
+/// bounce of the Whitted ray tracer.
+fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, f64, u32) {
+    let m = &scene.materials;
+    let reflects = m
+        .iter()
+        .any(|m| m.specular != Color::ZERO || m.transparent != Color::ZERO);
+    let depth = if reflects {
+        whitted
+            .depth
+            .depth_limit()
+            .map_or(whitted.max_depth, |d| d.min(whitted.max_depth))
+    } else {
+        0
+    };
+    let shadow = shadow_rays(scene, whitted.light_samples);
+    let glossy = m.iter().filter_map(|m| m.glossy).map(|g| g.samples).max().unwrap_or(1) as f64;
+    let split = if m.iter().any(|m| m.transparent != Color::ZERO) {
+        2.0
+    } else {
+        1.0
+    };
+    // Every hit casts its shadow rays; the first bounce fans out into the glossy rays,
+    // later ones follow one ray each; glass splits a path in two.
+    let per_sample = (1.0 + shadow) * (1.0 + glossy * depth as f64) * split;
+    // Every ray of the tree casts at most a shadow ray per light (`lightsamples` per
+    // quad light).
+    let most_shadow = shadow_rays(scene, whitted.light_samples.max(1));
+    let most = (1.0 + most_shadow) * whitted.tree_rays_bound(m);
+    (per_sample, most, shadow, depth)
+}
+
+fn warn_if_absurd(desc: &SceneDesc, work: &Work, spp: f64, shadow: f64, depth: u32, diags: &mut Diagnostics) {
+    if work.rays > ABSURD_RAYS || work.rays_per_pixel > ABSURD_RAYS_PER_PIXEL {
+        let (loc, what) = culprit(desc, spp, shadow, depth);
+        diags.warning(
+            loc,
+            format!(
+                "{what}: this render traces about {:.1e} rays ({:.1e} per pixel){}; Ctrl-C stops it",
+                work.rays,
+                work.rays_per_pixel,
+                if work.rays > ABSURD_RAYS {
+                    ", hours of work"
+                } else {
+                    ", far more than a picture needs"
+                }
+            ),
+        );
+    }
+}
+
+/// The setting that contributes the largest factor to the work, and its name.
+fn culprit(desc: &SceneDesc, spp: f64, shadow: f64, depth: u32) -> (Loc, &'static str) {
+    let at = |l: Option<Loc>| l.unwrap_or(desc.end);
+    let candidates = [
+        (spp, at(desc.spp.as_ref().map(|s| s.loc)), "spp"),
+        (shadow, at(desc.light_samples.as_ref().map(|s| s.loc)), "lightsamples"),
+        (depth as f64, at(desc.max_depth.as_ref().map(|s| s.loc)), "maxdepth"),
+    ];
+    let best = candidates
+        .into_iter()
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .expect("three candidates");
+    if best.0 > 1.0 {
+        (best.1, best.2)
+    } else {
+        (at(desc.size.as_ref().map(|s| s.loc)), "size")
+    }
+}
