@@ -134,7 +134,7 @@ fn build_parts(
     let scene = Scene::new(parts, options.accel);
     settings::control_depth(&mut integrator, &scene, desc.gamma() as f32);
     settings::warn_if_dark(desc, &scene, diags);
-    let work = work::estimate_work(desc, &scene, &integrator, width as u64 * height as u64, diags);
+    let work = work::estimate_work(desc, &scene, &integrator, Resolution { width, height }, diags);
     Some(Built {
         scene,
         integrator: integrator.into_box(),

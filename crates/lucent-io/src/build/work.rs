@@ -1,10 +1,20 @@
 //! The work a render of the scene asks for: the rays it traces, about and at most, and
 //! the warnings when that is more than any picture needs (the settings that ask for
 //! it: `spp`, `lightsamples`, `maxdepth`, `size`).
+//!
+//! "At most" follows from the settings and the materials alone (every glass hit
+//! splitting, every path going to its last bounce). "About" is measured where that is
+//! cheap: a probe traces one sample at 64 pixels spread over the image, as the render
+//! would, and counts their rays; the settings alone would take every pixel to see the
+//! scene's glass, and warned of hours of work for a gallery scene that takes seconds.
 
+use lucent_core::accel::AccelKind;
+use lucent_core::camera::Resolution;
 use lucent_core::integrator::path::{Nee, UNBOUNDED_SAFETY_CAP};
 use lucent_core::integrator::whitted::Whitted;
+use lucent_core::integrator::{CameraHit, Integrator, TraceCounts};
 use lucent_core::math::Color;
+use lucent_core::sampler::Sampler;
 use lucent_core::scene::Scene;
 
 use super::settings::Chosen;
@@ -31,9 +41,23 @@ pub struct Work {
 pub const ABSURD_RAYS: f64 = 1e10;
 pub const ABSURD_RAYS_PER_PIXEL: f64 = (1u64 << 20) as f64;
 
-/// Estimates the work of rendering the whole image (`pixels` of them), and warns at the
+/// The probe's pixels: a `PROBE_GRID` × `PROBE_GRID` grid over the image.
+const PROBE_GRID: u32 = 8;
+
+/// The rays the probe traces, about at most (twice this at the very most): a
+/// millisecond or two of one core.
+const PROBE_RAYS: u64 = 1 << 16;
+
+/// Estimates the work of rendering the whole image (at `resolution`), and warns at the
 /// setting responsible when it is absurd.
-pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u64, diags: &mut Diagnostics) -> Work {
+pub fn estimate_work(
+    desc: &SceneDesc,
+    scene: &Scene,
+    chosen: &Chosen,
+    resolution: Resolution,
+    diags: &mut Diagnostics,
+) -> Work {
+    let pixels = resolution.width as u64 * resolution.height as u64;
     let spp = desc.spp() as f64;
     let bounded = |depth: u32| depth as f64 + 1.0;
     // (rays per sample, at most, shadow rays per shading point, the deepest bounce)
@@ -67,6 +91,7 @@ pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u
             )
         }
     };
+    let per_sample = probe(scene, chosen, resolution, most).unwrap_or(per_sample);
     // The typical count never passes the bound (the tree's cap, chiefly).
     let per_sample = per_sample.min(most);
     let work = Work {
@@ -80,6 +105,58 @@ pub fn estimate_work(desc: &SceneDesc, scene: &Scene, chosen: &Chosen, pixels: u
         warn_if_cut(desc, scene, w, diags);
     }
     work
+}
+
+/// The rays one camera sample traces on average, measured on one sample at each of the
+/// probe's pixels, if that is cheap: `None` where one sample could take more than
+/// [`PROBE_RAYS`] (bounded by `most` rays, or a ray tree that the probe had to cut
+/// short), where the probe's samples together take more, and where the list's rays test
+/// every primitive and there are many.
+fn probe(scene: &Scene, chosen: &Chosen, resolution: Resolution, most: f64) -> Option<f64> {
+    // A ray of the list costs what a thousand of a tree do past a few hundred primitives.
+    let cost = match scene.accel_kind() {
+        AccelKind::List => (scene.geometry.primitives.len() as u64 / 256).max(1),
+        _ => 1,
+    };
+    let budget = PROBE_RAYS / cost;
+    let shortened;
+    let integrator: &dyn Integrator = match chosen {
+        Chosen::Whitted(w) => {
+            // Each probe sample's tree is cut short of the budget: a sample that gets
+            // there cannot be measured.
+            let per_ray = 1.0 + shadow_rays(scene, w.light_samples.max(1));
+            let cap = (budget as f64 / per_ray).min(w.max_tree_rays as f64);
+            if cap < 1.0 {
+                return None;
+            }
+            shortened = Whitted {
+                max_tree_rays: cap as u32,
+                ..*w
+            };
+            &shortened
+        }
+        _ if most > budget as f64 => return None,
+        Chosen::AnalyticDirect(i) => i,
+        Chosen::Direct(i) => i,
+        Chosen::PathTracer(i) => i,
+    };
+    let mut counts = TraceCounts::default();
+    let (w, h) = (resolution.width, resolution.height);
+    for j in 0..PROBE_GRID {
+        for i in 0..PROBE_GRID {
+            // The first rows alone would not stand for the image.
+            if counts.rays >= budget {
+                return None;
+            }
+            let x = ((2 * i + 1) as u64 * w as u64 / (2 * PROBE_GRID) as u64) as u32;
+            let y = ((2 * j + 1) as u64 * h as u64 / (2 * PROBE_GRID) as u64) as u32;
+            let ray = scene.camera.ray(resolution, x as f64 + 0.5, y as f64 + 0.5, (0.5, 0.5));
+            let mut sampler = Sampler::new(0x5eed_0f_9a7e, x, y, 0);
+            integrator.radiance(scene, &ray, CameraHit::Untraced, &mut sampler, &mut counts);
+        }
+    }
+    let samples = PROBE_GRID * PROBE_GRID;
+    (counts.cut_branches == 0).then(|| counts.rays as f64 / samples as f64)
 }
 
 /// Warns at `maxdepth` when a camera sample's ray tree could pass

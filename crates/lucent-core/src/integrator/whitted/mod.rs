@@ -107,6 +107,7 @@ enum Branch {
     },
 }
 
+#[derive(Clone, Copy, Debug)]
 pub struct Whitted {
     /// Bounces allowed after the primary hit.
     pub max_depth: u32,
