@@ -165,6 +165,7 @@ fn absurd_work_is_estimated_and_warned_about() {
         ("absurd_spp.test", "spp"),
         ("absurd_lightsamples.test", "lightsamples"),
         ("absurd_depth.test", "maxdepth"),
+        ("absurd_direct_depth.test", "maxdepth"),
     ] {
         let r = run(&dir, &["check", data(scene).to_str().unwrap()], seconds(30));
         assert_eq!(r.code, Some(0), "{scene}: {}", r.stderr);

@@ -83,6 +83,12 @@ impl Material {
             && self.bump_map.is_none()
     }
 
+    /// Whether its BSDF scatters into single directions only (a `brdf mirror`, glass):
+    /// [`Bsdf::is_delta`] wherever it is hit.
+    pub fn is_delta(&self) -> bool {
+        self.transparent != Color::ZERO || self.brdf == BrdfModel::Mirror
+    }
+
     /// The BSDF at a point with unit shading normal `normal`, the true surface's normal
     /// `geometric` (on the side of `normal`) and (textured) diffuse colour `diffuse`. A
     /// `transparent` material is a smooth dielectric, whatever its `brdf`.

@@ -68,7 +68,12 @@ pub fn estimate_work(
             let shadow = shadow_rays(scene, d.light_samples);
             // Through up to `maxdepth` mirrors and glass, then the lights' shadow rays.
             let most = bounded(d.max_delta_bounces) + sampled_shadow_rays(scene, d.light_samples);
-            (1.0 + shadow, most, shadow, 1)
+            if scene.materials.iter().any(|m| m.is_delta()) {
+                // A mirror sphere keeps every ray to the last bounce.
+                (most, most, shadow, d.max_delta_bounces)
+            } else {
+                (1.0 + shadow, most, shadow, 1)
+            }
         }
         Chosen::PathTracer(p) => {
             // A path's segments (about the depth, or a few with Russian roulette) each
