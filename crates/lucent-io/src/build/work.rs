@@ -118,7 +118,7 @@ pub fn estimate_work(
 /// short), where the probe's samples together take more, and where the list's rays test
 /// every primitive and there are many.
 fn probe(scene: &Scene, chosen: &Chosen, resolution: Resolution, most: f64) -> Option<f64> {
-    // A ray of the list costs what a thousand of a tree do past a few hundred primitives.
+    // Every ray of the list tests every primitive: the budget shrinks with their count.
     let cost = match scene.accel_kind() {
         AccelKind::List => (scene.geometry.primitives.len() as u64 / 256).max(1),
         _ => 1,
