@@ -25,9 +25,13 @@ use crate::math::Color;
 use crate::ray::Ray;
 use crate::sampler::{stratified, Sampler};
 use crate::scene::Scene;
-use job::{RenderJob, MIN_ADAPTIVE_SAMPLES};
+use job::{PixelRect, RenderJob, MIN_ADAPTIVE_SAMPLES};
 
+/// The side of a render's tiles, the pixels one thread renders at a time.
 pub const TILE_SIZE: u32 = 16;
+/// The smallest tiles, for pictures and regions too small to give every thread some
+/// tiles of [`TILE_SIZE`] (a block of camera rays, [`BLOCK`]², fills them).
+const MIN_TILE_SIZE: u32 = 4;
 /// The most samples per pixel whose lens positions are stratified (a table of this many
 /// entries per pixel, 256 kB).
 const MAX_LENS_STRATA: u32 = 1 << 16;
@@ -117,6 +121,23 @@ struct PixelResult {
     last: Color,
 }
 
+/// The side of the tiles `rect` is cut into for `threads` threads: [`TILE_SIZE`], or
+/// smaller where that would give fewer than four tiles a thread, so that a small picture
+/// or region of an expensive scene keeps every thread busy to the end and its progress
+/// moves. Where a pixel lands and what it sums do not depend on the tiles.
+fn tile_side(rect: PixelRect, threads: usize) -> u32 {
+    let tiles = |side: u32| {
+        let across = rect.x1.div_ceil(side) - rect.x0 / side;
+        let down = rect.y1.div_ceil(side) - rect.y0 / side;
+        across as usize * down as usize
+    };
+    let mut side = TILE_SIZE;
+    while side > MIN_TILE_SIZE && tiles(side) < 4 * threads {
+        side /= 2;
+    }
+    side
+}
+
 /// What a tile's pixels add to the film, row by row: their sums, and only where the job
 /// asks for them (empty otherwise: 150 bytes a pixel that every tile would clear and
 /// copy) the sums of their auxiliary passes and adaptive sampling's estimates.
@@ -177,13 +198,14 @@ pub fn render_after(
     }
     let rect = job.pixels;
     // Tiles of the whole image's grid, clipped to the rectangle.
-    let tiles: Vec<Tile> = (rect.y0 / TILE_SIZE..rect.y1.div_ceil(TILE_SIZE))
+    let side = tile_side(rect, rayon::current_num_threads());
+    let tiles: Vec<Tile> = (rect.y0 / side..rect.y1.div_ceil(side))
         .flat_map(|ty| {
-            (rect.x0 / TILE_SIZE..rect.x1.div_ceil(TILE_SIZE)).map(move |tx| Tile {
-                x0: (tx * TILE_SIZE).max(rect.x0),
-                y0: (ty * TILE_SIZE).max(rect.y0),
-                x1: ((tx + 1) * TILE_SIZE).min(rect.x1),
-                y1: ((ty + 1) * TILE_SIZE).min(rect.y1),
+            (rect.x0 / side..rect.x1.div_ceil(side)).map(move |tx| Tile {
+                x0: (tx * side).max(rect.x0),
+                y0: (ty * side).max(rect.y0),
+                x1: ((tx + 1) * side).min(rect.x1),
+                y1: ((ty + 1) * side).min(rect.y1),
             })
         })
         .collect();
@@ -486,6 +508,21 @@ fn shuffled_strata(seed: u64, x: u32, y: u32, n: u32, mut out: Vec<u32>) -> Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn small_pictures_are_cut_into_smaller_tiles_so_that_every_thread_has_some() {
+        let rect = |x0, y0, x1, y1| PixelRect { x0, y0, x1, y1 };
+        assert_eq!(tile_side(rect(0, 0, 640, 480), 2), 16);
+        assert_eq!(tile_side(rect(0, 0, 640, 480), 64), 16);
+        // 16 × 12 is one tile of 16: four of 8 for one thread, twelve of 4 for two.
+        assert_eq!(tile_side(rect(0, 0, 16, 12), 1), 8);
+        assert_eq!(tile_side(rect(0, 0, 16, 12), 2), 4);
+        // A region counts the tiles of the image's grid it touches: four pixels at the
+        // corner of four tiles are four tiles already, enough for one thread.
+        assert_eq!(tile_side(rect(15, 15, 17, 17), 1), 16);
+        assert_eq!(tile_side(rect(15, 15, 17, 17), 2), 4);
+        assert_eq!(tile_side(rect(0, 0, 1, 1), 8), MIN_TILE_SIZE);
+    }
 
     #[test]
     fn block_order_visits_every_pixel_of_a_tile_once_in_square_blocks() {
