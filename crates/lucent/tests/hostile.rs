@@ -204,6 +204,60 @@ fn ctrl_c_stops_a_billion_samples_at_once() {
     assert!(!dir.join("out.png").exists());
 }
 
+#[test]
+fn a_picture_larger_than_the_memory_budget_is_refused_before_it_is_rendered() {
+    let dir = workdir("picture_memory");
+    fs::write(
+        dir.join("big.test"),
+        "size 8192 8192\ncamera 0 0 5 0 0 0 0 1 0 45\npoint 1 1 1 1 1 1\nsphere 0 0 0 1\n",
+    )
+    .unwrap();
+    fs::write(dir.join("out.png"), b"an earlier picture").unwrap();
+    // Two samples of 67 million pixels: two films of sums and the image, some 10 GB.
+    let r = run(
+        &dir,
+        &[
+            "render",
+            "big.test",
+            "--spp",
+            "2",
+            "--memory-limit",
+            "1G",
+            "-o",
+            "out.png",
+        ],
+        seconds(30),
+    );
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    says(
+        &r,
+        "big.test:1:1: error: size: the picture (8192 x 8192 pixels, 2 samples each) needs about",
+    );
+    assert_eq!(fs::read(dir.join("out.png")).unwrap(), b"an earlier picture");
+    // A region of it fits.
+    let r = run(
+        &dir,
+        &[
+            "render",
+            "big.test",
+            "--spp",
+            "2",
+            "--memory-limit",
+            "1G",
+            "--pixel-bounds",
+            "4000",
+            "4100",
+            "4000",
+            "4100",
+            "-o",
+            "out.png",
+            "-q",
+        ],
+        seconds(30),
+    );
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+}
+
 // ---- 3. outputs ----
 
 /// A character device node `name` in `dir` (major, minor), so that a broken build under

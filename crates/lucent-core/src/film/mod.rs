@@ -39,7 +39,7 @@ enum Pixels {
     /// Any number of samples per pixel: the exact sums (48 bytes a pixel).
     Sums(Vec<ExactSum>),
     /// At most one sample per pixel: its value, from which its exact sum follows without
-    /// loss (see [`Film::one_sample`]; 12 bytes a pixel).
+    /// loss (see [`Film::one_sample`]; 16 bytes a pixel, a padded vector).
     Samples(Vec<Color>),
 }
 
@@ -58,6 +58,21 @@ impl Film {
             aovs,
             Pixels::Sums(crate::huge_pages::vec_filled(n, ExactSum::default())),
         )
+    }
+
+    /// The bytes a film of `pixels` pixels takes: their sums (or, with `one_sample`, their
+    /// samples), counts, auxiliary passes' sums (`aovs`) and adaptive sampling's
+    /// estimates (`noise`).
+    pub fn bytes(pixels: u64, one_sample: bool, aovs: bool, noise: bool) -> u64 {
+        use std::mem::size_of;
+        let colour = if one_sample {
+            size_of::<Color>()
+        } else {
+            size_of::<ExactSum>()
+        };
+        let aov = if aovs { size_of::<AovSum>() } else { 0 };
+        let noise = if noise { size_of::<PixelNoise>() } else { 0 };
+        pixels * (colour + size_of::<u32>() + aov + noise) as u64
     }
 
     /// A film for one sample of each pixel (a one-sample pass: the whole of a ray tracer's
@@ -283,6 +298,15 @@ fn one_sum(c: Color) -> ExactSum {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_films_bytes_are_what_docs_limits_md_says() {
+        assert_eq!(Film::bytes(1, true, false, false), 20);
+        assert_eq!(Film::bytes(1, false, false, false), 52);
+        assert_eq!(Film::bytes(1, false, true, false), 52 + 128);
+        assert_eq!(Film::bytes(1, true, false, true), 20 + 24);
+        assert_eq!(Film::bytes(1000, false, true, true), 1000 * (52 + 128 + 24));
+    }
 
     fn sum_of(samples: &[Color]) -> ExactSum {
         let mut s = ExactSum::default();
