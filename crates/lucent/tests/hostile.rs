@@ -214,9 +214,8 @@ fn a_picture_larger_than_the_memory_budget_is_refused_before_it_is_rendered() {
     .unwrap();
     fs::write(dir.join("out.png"), b"an earlier picture").unwrap();
     // Two samples of 67 million pixels: two films of sums and the image, some 10 GB.
-    let r = run(
-        &dir,
-        &[
+    let render = |extra: &[&str]| {
+        let mut args = vec![
             "render",
             "big.test",
             "--spp",
@@ -225,9 +224,11 @@ fn a_picture_larger_than_the_memory_budget_is_refused_before_it_is_rendered() {
             "1G",
             "-o",
             "out.png",
-        ],
-        seconds(30),
-    );
+        ];
+        args.extend_from_slice(extra);
+        run(&dir, &args, seconds(30))
+    };
+    let r = render(&[]);
     assert_eq!(r.code, Some(2), "{}", r.stderr);
     says(
         &r,
@@ -235,26 +236,7 @@ fn a_picture_larger_than_the_memory_budget_is_refused_before_it_is_rendered() {
     );
     assert_eq!(fs::read(dir.join("out.png")).unwrap(), b"an earlier picture");
     // A region of it fits.
-    let r = run(
-        &dir,
-        &[
-            "render",
-            "big.test",
-            "--spp",
-            "2",
-            "--memory-limit",
-            "1G",
-            "--pixel-bounds",
-            "4000",
-            "4100",
-            "4000",
-            "4100",
-            "-o",
-            "out.png",
-            "-q",
-        ],
-        seconds(30),
-    );
+    let r = render(&["--pixel-bounds", "4000", "4100", "4000", "4100", "-q"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
 }
 
