@@ -6,9 +6,12 @@ use std::path::PathBuf;
 use clap::Args;
 use lucent_core::accel::AccelKind;
 use lucent_io::desc::{LightKind, ProjectionDesc, ShapeKind, SurfaceRecipe};
+use lucent_io::resources::input::bytes;
 use lucent_io::session::{Session, SessionOptions};
 
+use crate::aov_args::AovSelection;
 use crate::output::report;
+use crate::picture::{picture_bytes, take_picture_memory, Extras};
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
@@ -32,9 +35,22 @@ pub fn run(args: &CheckArgs) -> u8 {
             .memory_limit
             .unwrap_or_else(lucent_io::resources::Budget::machine_default),
     };
-    let session = Session::open(&args.scene, options);
+    let mut session = Session::open(&args.scene, options);
+    // The picture's memory, as `render` takes it (without `--aov` or `--denoise`).
+    let scene_memory = session.res.budget.used();
+    let picture_memory = session.built.as_ref().map(|built| {
+        let extras = Extras {
+            aovs: AovSelection::default(),
+            denoiser: None,
+            threads: 1,
+        };
+        let job = built.job();
+        let need = picture_bytes(&job, false, &extras);
+        let fits = take_picture_memory(&mut session.res.budget, &mut session.diags, &session.desc, &job, need);
+        (need, fits)
+    });
     report(&session.diags, &session.desc.sources, true);
-    let (desc, Some(built)) = (&session.desc, &session.built) else {
+    let (desc, Some(built), Some((picture_memory, true))) = (&session.desc, &session.built, picture_memory) else {
         return EXIT_BAD_INPUT;
     };
 
@@ -123,6 +139,12 @@ pub fn run(args: &CheckArgs) -> u8 {
     println!(
         "work:       about {:.1e} rays ({:.0} per pixel, at most {:.0}), reflections up to depth {}",
         w.rays, w.rays_per_pixel, w.most_rays_per_pixel, w.depth
+    );
+    println!(
+        "memory:     about {} for the scene, {} for the picture (of {})",
+        bytes(scene_memory),
+        bytes(picture_memory),
+        bytes(session.res.budget.limit())
     );
     println!(
         "textures:   {}{}",

@@ -13,7 +13,7 @@ use lucent_io::denoise::{DenoiseInput, Denoiser};
 use lucent_io::desc::SceneDesc;
 use lucent_io::diag::Diagnostics;
 use lucent_io::image::encode_exr_channels;
-use lucent_io::resources::OutputTarget;
+use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::state::StateHeader;
 
 use crate::aov_args::AovSelection;
@@ -55,6 +55,31 @@ pub fn picture_bytes(job: &RenderJob, resumed: bool, extras: &Extras) -> u64 {
     let images = pixels * (32 + if aovs { 64 } else { 0 });
     let denoiser = if extras.denoiser.is_some() { pixels * 512 } else { 0 };
     films + images + denoiser
+}
+
+/// Takes the picture's memory ([`picture_bytes`]) from the run's `budget`; where it does
+/// not fit, an error at the scene's `size` (or the `--size` that replaced it) and `false`.
+pub fn take_picture_memory(
+    budget: &mut Budget,
+    diags: &mut Diagnostics,
+    desc: &SceneDesc,
+    job: &RenderJob,
+    need: u64,
+) -> bool {
+    let (width, height) = (job.pixels.width(), job.pixels.height());
+    let samples = match job.samples.len() {
+        1 => "1 sample".to_string(),
+        n => format!("{n} samples"),
+    };
+    let what = format!("the picture ({width} x {height} pixels, {samples} each)");
+    match budget.take(need, &what) {
+        Ok(()) => true,
+        Err(e) => {
+            let loc = desc.size.as_ref().map_or(desc.end, |s| s.loc);
+            diags.error(loc, format!("size: {e}"));
+            false
+        }
+    }
 }
 
 /// The EXR that holds the passes of a non-EXR output: `OUT.aovs.exr` beside it; `None`

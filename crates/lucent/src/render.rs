@@ -27,7 +27,7 @@ use crate::job_args::{apply_samples, parse_samples, pixel_rect, resume};
 use crate::output::{choose_output, report};
 use crate::partial::Partial;
 use crate::passes::{render_in_passes, Outcome};
-use crate::picture::{aov_file, picture_bytes, write_picture, Extras};
+use crate::picture::{aov_file, picture_bytes, take_picture_memory, write_picture, Extras};
 use crate::plan::{PlanRequest, Planned};
 use crate::progress::{Finish, Progress};
 use crate::settings_args::{overrides, quick};
@@ -427,14 +427,7 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     // The picture's memory comes out of the run's budget too: a 8192 x 8192 render with
     // every auxiliary pass would take some 20 GB.
     let need = picture_bytes(&job, resumed.is_some(), &extras);
-    let (width, height) = (job.pixels.width(), job.pixels.height());
-    let what = format!(
-        "the picture ({width} x {height} pixels, {} samples each)",
-        job.samples.len()
-    );
-    if let Err(e) = session.res.budget.take(need, &what) {
-        let loc = session.desc.size.as_ref().map_or(session.desc.end, |s| s.loc);
-        session.diags.error(loc, format!("size: {e}"));
+    if !take_picture_memory(&mut session.res.budget, &mut session.diags, &session.desc, &job, need) {
         report(&session.diags, &session.desc.sources, false);
         return EXIT_BAD_INPUT;
     }

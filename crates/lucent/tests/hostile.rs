@@ -238,6 +238,16 @@ fn a_picture_larger_than_the_memory_budget_is_refused_before_it_is_rendered() {
     // A region of it fits.
     let r = render(&["--pixel-bounds", "4000", "4100", "4000", "4100", "-q"]);
     assert_eq!(r.code, Some(0), "{}", r.stderr);
+    // `check` says so too (its picture: one sample, 20 bytes a pixel and the image).
+    let r = run(&dir, &["check", "big.test", "--memory-limit", "1G"], seconds(30));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    says(
+        &r,
+        "big.test:1:1: error: size: the picture (8192 x 8192 pixels, 1 sample each) needs about",
+    );
+    let r = run(&dir, &["check", "big.test", "--memory-limit", "8G"], seconds(30));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(String::from_utf8_lossy(&r.stdout).contains("for the picture (of 8.0 GB)"));
 }
 
 // ---- 3. outputs ----
