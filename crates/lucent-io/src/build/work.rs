@@ -60,9 +60,15 @@ pub fn estimate_work(
     let pixels = resolution.width as u64 * resolution.height as u64;
     let spp = desc.spp() as f64;
     let bounded = |depth: u32| depth as f64 + 1.0;
+    // The ray tracer, and the most rays of one sample's tree (shadow rays left out).
+    let mut whitted_tree = None;
     // (rays per sample, at most, shadow rays per shading point, the deepest bounce)
     let (per_sample, most, shadow, depth) = match chosen {
-        Chosen::Whitted(w) => whitted_rays(scene, w),
+        Chosen::Whitted(w) => {
+            let tree = w.tree_rays_bound(&scene.materials);
+            whitted_tree = Some((w, tree));
+            whitted_rays(scene, w, tree)
+        }
         Chosen::AnalyticDirect(_) => (1.0, 1.0, 0.0, 1),
         Chosen::Direct(d) => {
             let shadow = shadow_rays(scene, d.light_samples);
@@ -106,8 +112,8 @@ pub fn estimate_work(
         depth,
     };
     warn_if_absurd(desc, &work, spp, shadow, depth, diags);
-    if let Chosen::Whitted(w) = chosen {
-        warn_if_cut(desc, scene, w, diags);
+    if let Some((w, tree)) = whitted_tree {
+        warn_if_cut(desc, scene, w, tree, diags);
     }
     work
 }
@@ -165,9 +171,10 @@ fn probe(scene: &Scene, chosen: &Chosen, resolution: Resolution, most: f64) -> O
 }
 
 /// Warns at `maxdepth` when a camera sample's ray tree could pass
-/// [`Whitted::max_tree_rays`], where the renderer cuts it.
-fn warn_if_cut(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, diags: &mut Diagnostics) {
-    if whitted.tree_rays_bound(&scene.materials) < whitted.max_tree_rays as f64 {
+/// [`Whitted::max_tree_rays`], where the renderer cuts it (`tree`: the most rays of one,
+/// [`Whitted::tree_rays_bound`]).
+fn warn_if_cut(desc: &SceneDesc, scene: &Scene, whitted: &Whitted, tree: f64, diags: &mut Diagnostics) {
+    if tree < whitted.max_tree_rays as f64 {
         return;
     }
     let loc = desc.max_depth.as_ref().map(|d| d.loc).unwrap_or(desc.end);
@@ -208,9 +215,9 @@ fn sampled_shadow_rays(scene: &Scene, samples: u32) -> f64 {
         .sum()
 }
 
-/// Rays per sample (about, and at most), shadow rays per shading point and the deepest
-/// bounce of the Whitted ray tracer.
-fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, f64, u32) {
+/// Rays per sample (about, and at most, from `tree`, the most rays of one sample's tree),
+/// shadow rays per shading point and the deepest bounce of the Whitted ray tracer.
+fn whitted_rays(scene: &Scene, whitted: &Whitted, tree: f64) -> (f64, f64, f64, u32) {
     let m = &scene.materials;
     let reflects = m
         .iter()
@@ -236,7 +243,7 @@ fn whitted_rays(scene: &Scene, whitted: &Whitted) -> (f64, f64, f64, u32) {
     // Every ray of the tree casts at most a shadow ray per light (`lightsamples` per
     // quad light).
     let most_shadow = shadow_rays(scene, whitted.light_samples.max(1));
-    let most = (1.0 + most_shadow) * whitted.tree_rays_bound(m);
+    let most = (1.0 + most_shadow) * tree;
     (per_sample, most, shadow, depth)
 }
 
