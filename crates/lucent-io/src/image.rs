@@ -27,7 +27,14 @@ pub fn encode_png(width: u32, height: u32, rgb: &[u8], info: &ImageInfo) -> Resu
             (0.15, 0.06),
         ));
         for (k, v) in &info.text {
-            enc.add_text_chunk(k.clone(), v.clone()).map_err(|e| e.to_string())?;
+            // tEXt holds Latin-1 only; other text (a scene named in Chinese) goes in an
+            // iTXt chunk, which holds UTF-8.
+            let added = if v.chars().all(|c| (c as u32) < 256) {
+                enc.add_text_chunk(k.clone(), v.clone())
+            } else {
+                enc.add_itxt_chunk(k.clone(), v.clone())
+            };
+            added.map_err(|e| e.to_string())?;
         }
         let mut w = enc.write_header().map_err(|e| e.to_string())?;
         w.write_image_data(rgb).map_err(|e| e.to_string())?;
@@ -94,7 +101,9 @@ pub fn encode_exr_channels(
         info.text
             .iter()
             .find(|(k, _)| k == key)
-            .map(|(_, v)| Text::from(v.as_str()))
+            // An EXR string is bytes (size-prefixed): UTF-8, as OpenEXR's own tools
+            // read it. (`Text::from` panics on anything past Latin-1.)
+            .map(|(_, v)| Text::from_slice_unchecked(v.as_bytes()))
     };
     attributes.software_name = text("Software");
     attributes.comments = text("Comment");

@@ -410,6 +410,19 @@ fn images_carry_what_they_are() {
     assert!(find(format!("Software\0lucent {}", env!("CARGO_PKG_VERSION")).as_bytes()).is_some());
     assert!(find(b"Source\0a.test").is_some());
     assert!(find(b"32 x 24 image, pixels 0..32 x 0..24, samples 0..0 of 1 per pixel").is_some());
+    // A scene named past Latin-1 (which tEXt and the EXR crate's text hold): its name in
+    // an iTXt chunk, and as UTF-8 bytes in an EXR's comments (before, the PNG was refused
+    // and the EXR write panicked, after the whole render).
+    let name = "场景 ✓.test";
+    fs::write(dir.join(name), SCENE).unwrap();
+    for out in ["u.png", "u.exr"] {
+        let o = lucent(&dir, &["render", name, "-o", out, "-q"]);
+        assert!(o.status.success(), "{out}: {}", stderr(&o));
+        let bytes = fs::read(dir.join(out)).unwrap();
+        assert!(bytes.windows(name.len()).any(|w| w == name.as_bytes()), "{out}");
+    }
+    let png = fs::read(dir.join("u.png")).unwrap();
+    assert!(png.windows(11).any(|w| w == b"iTXtSource\0"));
     // Linear output says so: gAMA 1.
     fs::write(dir.join("b.test"), SCENE).unwrap();
     assert!(lucent(&dir, &["render", "b.test", "-o", "y.png", "-q"])
