@@ -31,11 +31,13 @@
 //! all (a temporary file renamed), and a file whose checksum does not match is refused.
 
 use std::ops::Range;
+use std::path::Path;
 
 use lucent_core::film::{AovSum, ExactSum, Film, PixelNoise};
 use lucent_core::render::job::PixelRect;
 
 use crate::fnv::{fnv1a, START as FNV_START};
+use crate::resources::{io_reason, read_input, Budget, Inputs};
 
 /// What a render state holds.
 #[derive(Clone, Debug, PartialEq)]
@@ -241,6 +243,13 @@ impl RenderState {
         if !(samples.start < samples.end && samples.end <= spp) {
             return Err("the header's samples are not a range within its spp".into());
         }
+        // (As the scene and the command line take them.)
+        if !(gamma > 0.0 && gamma.is_finite()) {
+            return Err(format!("the header's gamma {gamma} is not a number > 0"));
+        }
+        if let Some(t) = noise_threshold.filter(|t| !(*t >= 0.0 && t.is_finite())) {
+            return Err(format!("the header's noise threshold {t} is not a number >= 0"));
+        }
         let header = StateHeader {
             scene_hash,
             scene_name,
@@ -275,11 +284,18 @@ impl RenderState {
         if noise_threshold.is_some() {
             film.noise = Some(vec![PixelNoise::default(); n]);
         }
+        let damaged = || "its pixel data is not what a state file holds (a damaged file)".to_string();
         for (k, px) in body.chunks_exact(size).enumerate() {
             let i = |j: usize| i128::from_le_bytes(px[16 * j..16 * j + 16].try_into().unwrap());
             let u = |at: usize| u32::from_le_bytes(px[at..at + 4].try_into().unwrap());
-            film.sums_mut()[k] = ExactSum([i(0), i(1), i(2)]);
-            film.counts[k] = u(48);
+            let (sum, count) = (ExactSum([i(0), i(1), i(2)]), u(48));
+            // What no render makes: more samples than the file's range holds, or a sum
+            // beyond what its samples can add up to (each is clamped: ExactSum).
+            if count > header.samples.len() as u32 || !sum.within(count) {
+                return Err(damaged());
+            }
+            film.sums_mut()[k] = sum;
+            film.counts[k] = count;
             let mut at = BEAUTY_BYTES;
             if let Some(aovs) = &mut film.aovs {
                 let a = &px[at..];
@@ -290,6 +306,14 @@ impl RenderState {
                     depth: i(6),
                     hits: u(at + 112),
                 };
+                let a = &aovs[k];
+                if a.hits > count
+                    || !a.albedo.within(count)
+                    || !a.normal.within(count)
+                    || !ExactSum([a.depth, 0, 0]).within(a.hits)
+                {
+                    return Err(damaged());
+                }
                 at += AOV_BYTES;
             }
             if let Some(noise) = &mut film.noise {
@@ -300,13 +324,82 @@ impl RenderState {
                     stopped: match px[at + 16] {
                         0 => false,
                         1 => true,
-                        _ => return Err("its pixel data is not what a state file holds (a damaged file)".into()),
+                        _ => return Err(damaged()),
                     },
                 };
+                if !(noise[k].sum.is_finite() && noise[k].sum_sq >= 0.0 && noise[k].sum_sq.is_finite()) {
+                    return Err(damaged());
+                }
             }
         }
         Ok(RenderState { header, film })
     }
+}
+
+/// Reads the state file at `path` (a regular file, as [`read_input`] takes it) and takes
+/// its memory from `budget`: the file's bytes while they are decoded, and the film they
+/// become, which stays taken ([`RenderState::film_bytes`] gives it back). A film takes at
+/// most 1.5 times its bytes in the file (a pixel's noise estimate, 17 bytes there, is 24
+/// in memory; everything else about the same), so that much is taken before reading.
+pub fn read_state(path: &Path, budget: &mut Budget, inputs: &mut Inputs) -> Result<RenderState, String> {
+    let size = std::fs::metadata(path).map_err(|e| io_reason(&e))?.len();
+    let taken = size.saturating_add(size / 2 * 3 + 2);
+    budget.take(taken, "the state file and its film")?;
+    // (Held to the size just looked at: a file that grew since is refused.)
+    let state = read_input(path, size, inputs).and_then(|bytes| RenderState::decode(&bytes));
+    let kept = state.as_ref().map_or(0, |s| s.film_bytes().min(taken));
+    budget.give_back(taken - kept);
+    state
+}
+
+impl RenderState {
+    /// The memory its film takes (what [`read_state`] keeps taken).
+    pub fn film_bytes(&self) -> u64 {
+        let f = &self.film;
+        Film::bytes(f.counts.len() as u64, false, f.aovs.is_some(), f.noise.is_some())
+    }
+}
+
+/// The message for inputs that leave a gap: the first pixel (row by row) that lacks some
+/// of `range`'s samples. How many samples cover a pixel changes only at the states' edges,
+/// so one pixel of each cell of the grid those edges make stands for the whole cell.
+fn gap(states: &[RenderState], union: &PixelRect, range: &Range<u32>) -> String {
+    let edges = |ends: &dyn Fn(&PixelRect) -> [u32; 2]| {
+        let mut v: Vec<u32> = states.iter().flat_map(|s| ends(&s.header.pixels)).collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    let (xs, ys) = (edges(&|p| [p.x0, p.x1]), edges(&|p| [p.y0, p.y1]));
+    for &y in &ys[..ys.len() - 1] {
+        for &x in &xs[..xs.len() - 1] {
+            let covered: u64 = states
+                .iter()
+                .filter(|s| {
+                    let p = s.header.pixels;
+                    (p.x0..p.x1).contains(&x) && (p.y0..p.y1).contains(&y)
+                })
+                .map(|s| s.header.samples.len() as u64)
+                .sum();
+            if covered != range.len() as u64 {
+                return format!(
+                    "a gap: pixel ({x}, {y}) has {covered} of the samples {}..{} that the inputs hold together",
+                    range.start,
+                    range.end - 1
+                );
+            }
+        }
+    }
+    // (Not reached: the counts differ, so some cell lacks samples.)
+    format!(
+        "a gap: the inputs do not hold every sample {}..{} of pixels {}..{} x {}..{}",
+        range.start,
+        range.end - 1,
+        union.x0,
+        union.x1,
+        union.y0,
+        union.y1
+    )
 }
 
 fn overlap(a: &PixelRect, b: &PixelRect) -> bool {
@@ -424,17 +517,25 @@ pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, St
             }
         }
     }
+    // With no overlaps, the inputs hold every sample index of `range` for every pixel of
+    // `union` exactly when they hold as many pixel samples as the two span. Checked before
+    // the merged film is made, so that two small states at far corners of a large image
+    // cannot ask for the film of all of it: once they pass, the film has no more pixels
+    // than the inputs together.
+    let held: u128 = states
+        .iter()
+        .map(|s| s.header.pixels.pixels() as u128 * s.header.samples.len() as u128)
+        .sum();
+    if held != union.pixels() as u128 * range.len() as u128 {
+        return Err(gap(states, &union, &range));
+    }
     let mut film = Film::with_aovs(union.width(), union.height(), first.header.aovs);
     if first.header.noise_threshold.is_some() {
         film.noise = Some(vec![PixelNoise::default(); film.counts.len()]);
     }
-    // How many sample indices cover each pixel: with no overlaps, all of `range` exactly
-    // when it is the range's length.
-    let mut covered = vec![0u32; film.counts.len()];
     let w = union.width() as usize;
     for s in states {
         let p = s.header.pixels;
-        let len = s.header.samples.len() as u32;
         for y in 0..p.height() {
             for x in 0..p.width() {
                 let src = (y * p.width() + x) as usize;
@@ -444,18 +545,8 @@ pub fn merge(states: &[RenderState], names: &[String]) -> Result<RenderState, St
                 if let (Some(to), Some(from)) = (&mut film.noise, &s.film.noise) {
                     to[dst] = from[src];
                 }
-                covered[dst] += len;
             }
         }
-    }
-    if let Some(k) = covered.iter().position(|&c| c != range.len() as u32) {
-        let (x, y) = (union.x0 + (k % w) as u32, union.y0 + (k / w) as u32);
-        return Err(format!(
-            "a gap: pixel ({x}, {y}) has {} of the samples {}..{} that the inputs hold together",
-            covered[k],
-            range.start,
-            range.end - 1
-        ));
     }
     Ok(RenderState {
         header: StateHeader {
@@ -529,6 +620,92 @@ mod tests {
     }
 
     #[test]
+    fn states_no_render_makes_are_refused() {
+        // Checksums are right: these are what a tool, not a damaged disk, would write.
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.film.counts[1] = 5;
+        let e = RenderState::decode(&s.encode()).unwrap_err();
+        assert!(e.contains("not what a state file holds"), "{e}");
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.film.sums_mut()[3].0[2] = i128::MAX;
+        let e = RenderState::decode(&s.encode()).unwrap_err();
+        assert!(e.contains("not what a state file holds"), "{e}");
+        for gamma in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            let mut s = state(rect(0, 2, 0, 2), 4..8);
+            s.header.gamma = gamma;
+            let e = RenderState::decode(&s.encode()).unwrap_err();
+            assert!(e.contains("gamma"), "{e}");
+        }
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.header.noise_threshold = Some(f32::NAN);
+        s.film.noise = Some(vec![PixelNoise::default(); 4]);
+        assert!(RenderState::decode(&s.encode())
+            .unwrap_err()
+            .contains("noise threshold"));
+        s.header.noise_threshold = Some(0.1);
+        s.film.noise.as_mut().unwrap()[2].sum = f64::NAN;
+        assert!(RenderState::decode(&s.encode())
+            .unwrap_err()
+            .contains("not what a state file holds"));
+        // At the clamp in every sample: still a state.
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.film.sums_mut()[0] = ExactSum([4 * (1i128 << 104), -4 * (1i128 << 104), 0]);
+        assert_eq!(RenderState::decode(&s.encode()).unwrap(), s);
+    }
+
+    /// The gap's message names the first pixel, row by row, that the states do not hold
+    /// every sample of: the same as counting every pixel's samples.
+    #[test]
+    fn the_gap_found_on_the_states_grid_is_the_first_pixel_short_of_samples() {
+        let mut seed = 12345u32;
+        let mut next = |n: u32| {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) % n
+        };
+        let mut gaps = 0;
+        for _ in 0..500 {
+            let states: Vec<RenderState> = (0..1 + next(4))
+                .map(|_| {
+                    let (x0, y0) = (next(7), next(5));
+                    let (x1, y1) = (x0 + 1 + next(8 - x0), y0 + 1 + next(6 - y0));
+                    let first = next(3);
+                    state(rect(x0, x1, y0, y1), first..first + 1 + next(3))
+                })
+                .collect();
+            let union = PixelRect {
+                x0: states.iter().map(|s| s.header.pixels.x0).min().unwrap(),
+                x1: states.iter().map(|s| s.header.pixels.x1).max().unwrap(),
+                y0: states.iter().map(|s| s.header.pixels.y0).min().unwrap(),
+                y1: states.iter().map(|s| s.header.pixels.y1).max().unwrap(),
+            };
+            let range = 0..5;
+            let brute = (union.y0..union.y1)
+                .flat_map(|y| (union.x0..union.x1).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let n: u64 = states
+                        .iter()
+                        .filter(|s| {
+                            let p = s.header.pixels;
+                            p.x0 <= x && x < p.x1 && p.y0 <= y && y < p.y1
+                        })
+                        .map(|s| s.header.samples.len() as u64)
+                        .sum();
+                    (x, y, n)
+                })
+                .find(|&(_, _, n)| n != 5);
+            if let Some((x, y, n)) = brute {
+                gaps += 1;
+                let e = gap(&states, &union, &range);
+                assert_eq!(
+                    e,
+                    format!("a gap: pixel ({x}, {y}) has {n} of the samples 0..4 that the inputs hold together")
+                );
+            }
+        }
+        assert!(gaps > 400, "{gaps}");
+    }
+
+    #[test]
     fn auxiliary_passes_and_adaptive_estimates_survive_a_round_trip() {
         let mut s = state(rect(0, 3, 1, 3), 0..16);
         s.header.aovs = true;
@@ -593,6 +770,25 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.contains("gap: pixel (2, 0)"), "{e}");
+        // An L of two states leaves a corner.
+        let e = merge(
+            &[state(rect(0, 8, 0, 2), 0..16), state(rect(0, 4, 2, 4), 0..16)],
+            &names,
+        )
+        .unwrap_err();
+        assert!(e.contains("gap: pixel (4, 2) has 0 of the samples 0..15"), "{e}");
+        // Two pixels at the far corners of a 65535 x 65535 image: a gap, found before the
+        // film of the rectangle between them (223 GB) is made.
+        let corners: Vec<RenderState> = [rect(0, 1, 0, 1), rect(65534, 65535, 65534, 65535)]
+            .into_iter()
+            .map(|r| {
+                let mut s = state(r, 0..16);
+                s.header.resolution = (65535, 65535);
+                s
+            })
+            .collect();
+        let e = merge(&corners, &names).unwrap_err();
+        assert!(e.contains("gap: pixel (1, 0) has 0 of"), "{e}");
         // Another scene.
         let mut other = state(rect(4, 8, 0, 4), 0..16);
         other.header.scene_hash = 1;

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use lucent_core::accel::AccelKind;
+use lucent_io::build::warn_if_absurd;
 use lucent_io::desc::{LightKind, ProjectionDesc, ShapeKind, SurfaceRecipe};
 use lucent_io::resources::input::bytes;
 use lucent_io::session::{Session, SessionOptions};
@@ -36,6 +37,9 @@ pub fn run(args: &CheckArgs) -> u8 {
             .unwrap_or_else(lucent_io::resources::Budget::machine_default),
     };
     let mut session = Session::open(&args.scene, options);
+    if let Some(built) = &session.built {
+        warn_if_absurd(&session.desc, &built.work, &mut session.diags);
+    }
     // The picture's memory, as `render` takes it (without `--aov` or `--denoise`).
     let scene_memory = session.res.budget.used();
     let picture_memory = session.built.as_ref().map(|built| {

@@ -4,7 +4,8 @@
 //! `--resume STATE` (what an earlier render left to do).
 
 use lucent_core::render::job::{PixelRect, RenderJob};
-use lucent_io::state::{RenderState, StateHeader};
+use lucent_io::resources::{Budget, Inputs};
+use lucent_io::state::{read_state, RenderState, StateHeader};
 
 /// `--samples FIRST..LAST`: the inclusive range as `FIRST..LAST+1`.
 pub fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
@@ -82,9 +83,14 @@ pub fn apply_samples(job: &mut RenderJob, samples: &std::ops::Range<u32>) -> Res
 /// Reads the state to continue and points `job` at what is left: its pixels, the sample
 /// indices from its end to `job.spp`. The state must be of this scene and these options,
 /// from an integrator whose samples do not depend on the total (the Monte Carlo ones).
-pub fn resume(path: &std::path::Path, job: &mut RenderJob, now: &StateHeader) -> Result<RenderState, String> {
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    let state = RenderState::decode(&bytes)?;
+/// The state's film is taken from `budget` (and stays taken).
+pub fn resume(
+    path: &std::path::Path,
+    job: &mut RenderJob,
+    now: &StateHeader,
+    budget: &mut Budget,
+) -> Result<RenderState, String> {
+    let state = read_state(path, budget, &mut Inputs::default())?;
     let h = &state.header;
     // The passes the state keeps are continued whether or not they are asked for again.
     if job.aovs && !h.aovs {

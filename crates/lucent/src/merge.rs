@@ -1,19 +1,22 @@
-//! `lucent merge A.lstate B.lstate … -o OUT.png|OUT.exr|OUT.hdr [--state OUT.lstate] [--aov …] [--denoise] [--threads N]`:
+//! `lucent merge A.lstate B.lstate … -o OUT.png|OUT.exr|OUT.hdr [--state OUT.lstate] [--aov …] [--denoise] [--threads N] [--memory-limit SIZE]`:
 //! the render that states of regions and sample ranges of one scene make together — the
 //! bytes of rendering it in one go. Inputs of another scene or other options, overlaps
-//! and gaps are refused with a message that names the files.
+//! and gaps are refused with a message that names the files. The states are read as
+//! every input is (regular files only), their films and the picture come out of a
+//! memory budget, and no output may replace one of the inputs.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use lucent_io::desc::SceneDesc;
 use lucent_io::diag::Diagnostics;
-use lucent_io::resources::OutputTarget;
-use lucent_io::state::{merge, RenderState};
+use lucent_io::resources::{Budget, Inputs, OutputTarget};
+use lucent_io::state::{merge, read_state};
 
 use crate::aov_args::{parse_aovs, AovSelection};
 use crate::output::choose_output;
-use crate::picture::{aov_file, write_picture, Extras};
+use crate::picture::{aov_file, image_bytes, write_picture, Extras};
+use crate::render::parse_size;
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
@@ -38,6 +41,9 @@ pub struct MergeArgs {
     /// Threads for the denoiser (default: all cores).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub threads: Option<u32>,
+    /// The memory the merge may take (e.g. 4G, 512M); default: 3/4 of the machine's.
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub memory_limit: Option<u64>,
 }
 
 pub fn run(args: &MergeArgs) -> u8 {
@@ -57,18 +63,26 @@ pub fn run(args: &MergeArgs) -> u8 {
         ),
     };
     let names: Vec<String> = args.inputs.iter().map(|p| p.display().to_string()).collect();
+    let mut budget = Budget::new(args.memory_limit.unwrap_or_else(Budget::machine_default));
+    let mut inputs = Inputs::default();
     let mut states = Vec::with_capacity(args.inputs.len());
     for (path, name) in args.inputs.iter().zip(&names) {
-        match std::fs::read(path)
-            .map_err(|e| e.to_string())
-            .and_then(|b| RenderState::decode(&b))
-        {
+        match read_state(path, &mut budget, &mut inputs) {
             Ok(s) => states.push(s),
             Err(e) => {
                 eprintln!("lucent: error: {name}: {e}");
                 return EXIT_BAD_INPUT;
             }
         }
+    }
+    // The merged film has no more pixels than the inputs together (merge checks that
+    // they leave no gap before making it), so it is taken before it is made.
+    let pixels: u64 = states.iter().map(|s| s.header.pixels.pixels()).sum();
+    let aovs = states[0].header.aovs;
+    let picture = states.iter().map(|s| s.film_bytes()).sum::<u64>() + image_bytes(pixels, aovs, &extras);
+    if let Err(e) = budget.take(picture, "the merged picture") {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
     }
     let merged = match merge(&states, &names) {
         Ok(m) => m,
@@ -77,6 +91,7 @@ pub fn run(args: &MergeArgs) -> u8 {
             return EXIT_BAD_INPUT;
         }
     };
+    drop(states);
     let mut diags = Diagnostics::default();
     let out = match choose_output(Some(&args.output), &SceneDesc::default(), &mut diags) {
         Ok(o) => o,
@@ -89,17 +104,38 @@ pub fn run(args: &MergeArgs) -> u8 {
         eprintln!("lucent: error: --aov and --denoise need the auxiliary passes, and these states keep none: render them with --aov or --denoise");
         return EXIT_BAD_INPUT;
     }
-    if let Err(e) = aov_file(&out, extras.aovs) {
-        eprintln!("lucent: error: {e}");
-        return EXIT_BAD_INPUT;
+    let aov_side = match aov_file(&out, extras.aovs) {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    let state_out = match args.state.as_deref().map(OutputTarget::resolve).transpose() {
+        Ok(t) => t,
+        Err(e) => {
+            let name = args.state.as_ref().map_or(String::new(), |p| p.display().to_string());
+            eprintln!("lucent: error: cannot write {name}: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
+    // No output may replace an input: the states stay as they were, so that a merge of
+    // the wrong list can be made again.
+    let targets = std::iter::once((&out.name, &out.target))
+        .chain(aov_side.iter().map(|a| (&a.name, &a.target)))
+        .chain(args.state.iter().zip(&state_out));
+    for (name, target) in targets {
+        if let Err(e) = target.check_not_input(&inputs) {
+            eprintln!("lucent: error: cannot write {}: {e}", name.display());
+            return EXIT_BAD_INPUT;
+        }
     }
     if let Err(e) = write_picture(&out, &merged.film, &merged.header, &extras) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
-    if let Some(path) = &args.state {
-        let written = OutputTarget::resolve(path).and_then(|t| t.write(&merged.encode()));
-        if let Err(e) = written {
+    if let (Some(path), Some(target)) = (&args.state, &state_out) {
+        if let Err(e) = target.write(&merged.encode()) {
             eprintln!("lucent: error: cannot write {}: {e}", path.display());
             return EXIT_BAD_INPUT;
         }

@@ -51,10 +51,16 @@ pub fn picture_bytes(job: &RenderJob, resumed: bool, extras: &Extras) -> u64 {
     } else {
         Film::bytes(pixels, true, aovs, noise) + 2 * Film::bytes(pixels, false, aovs, noise)
     };
-    // The colour as floats and as written; each auxiliary pass as floats (up to four).
+    films + image_bytes(pixels, aovs, extras)
+}
+
+/// What [`write_picture`] makes of a film of `pixels` pixels: the colour as floats and as
+/// written, each auxiliary pass as floats (up to four, where the film keeps them:
+/// `aovs`), and the denoiser's buffers.
+pub fn image_bytes(pixels: u64, aovs: bool, extras: &Extras) -> u64 {
     let images = pixels * (32 + if aovs { 64 } else { 0 });
     let denoiser = if extras.denoiser.is_some() { pixels * 512 } else { 0 };
-    films + images + denoiser
+    images + denoiser
 }
 
 /// Takes the picture's memory ([`picture_bytes`]) from the run's `budget`; where it does

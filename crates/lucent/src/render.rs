@@ -17,6 +17,8 @@ use lucent_core::math::Color;
 use lucent_core::render::job::RenderJob;
 use lucent_core::render::plan::Cut;
 use lucent_core::sampler::SamplerKind;
+use lucent_io::build::warn_if_absurd;
+use lucent_io::diag::Diagnostics;
 use lucent_io::resources::input::FileId;
 use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::session::{Renderer, Session, SessionOptions};
@@ -415,7 +417,7 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     }
     let now = header(&job);
     let resumed = match &args.resume {
-        Some(path) => match resume(path, &mut job, &now) {
+        Some(path) => match resume(path, &mut job, &now, &mut session.res.budget) {
             Ok(s) => Some(s),
             Err(e) => {
                 eprintln!("lucent: error: --resume {}: {e}", path.display());
@@ -426,11 +428,21 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     };
     // The picture's memory comes out of the run's budget too: a 8192 x 8192 render with
     // every auxiliary pass would take some 20 GB.
+    // (The resumed film is one of the picture's: taken again below.)
+    if let Some(s) = &resumed {
+        session.res.budget.give_back(s.film_bytes());
+    }
     let need = picture_bytes(&job, resumed.is_some(), &extras);
     if !take_picture_memory(&mut session.res.budget, &mut session.diags, &session.desc, &job, need) {
         report(&session.diags, &session.desc.sources, false);
         return EXIT_BAD_INPUT;
     }
+    // Absurd work is this render's: its pixels and samples, not the whole picture's at
+    // the scene's spp (a task of a plan, a region, --spp).
+    let mut later = Diagnostics::default();
+    let work = built.work.of_render(job.pixels.pixels(), job.samples.len() as u32);
+    warn_if_absurd(&session.desc, &work, &mut later);
+    report(&later, &session.desc.sources, false);
     let progress = Progress::new(job.pixels.pixels() * job.samples.len() as u64, args.quiet);
     let cancel = signals::cancel_flag();
     let t_render = Instant::now();

@@ -176,6 +176,60 @@ fn absurd_work_is_estimated_and_warned_about() {
             "{scene}"
         );
     }
+    // A render warns of its own work: a few of a billion samples, or a corner of a huge
+    // picture, are no hours of work; the same scene at a billion samples from the
+    // command line is.
+    fs::write(
+        dir.join("big.test"),
+        "size 8192 8192\ncamera 0 0 5 0 0 0 0 1 0 45\nspp 1024\npoint 0 1 5 1 1 1\nsphere 0 0 0 1\n",
+    )
+    .unwrap();
+    let spp = data("absurd_spp.test");
+    let spp = spp.to_str().unwrap();
+    for args in [
+        vec!["render", spp, "-o", "a.png", "--samples", "0..3"],
+        vec![
+            "render",
+            "big.test",
+            "-o",
+            "b.png",
+            "--pixel-bounds",
+            "0",
+            "8",
+            "0",
+            "8",
+        ],
+    ] {
+        let r = run(&dir, &args, seconds(30));
+        assert_eq!(r.code, Some(0), "{args:?}: {}", r.stderr);
+        assert!(!r.stderr.contains("this render traces"), "{args:?}: {}", r.stderr);
+    }
+    let r = run(&dir, &["check", "big.test"], seconds(30));
+    says(
+        &r,
+        "spp: this render traces about 6.9e10 rays (1.0e3 per pixel, 1024 samples each), hours of work",
+    );
+    let r = run(
+        &dir,
+        &[
+            "render",
+            "big.test",
+            "-o",
+            "b.png",
+            "--pixel-bounds",
+            "0",
+            "8",
+            "0",
+            "8",
+            "--spp",
+            "1000000000",
+            "--samples",
+            "0..0",
+        ],
+        seconds(30),
+    );
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+    assert!(!r.stderr.contains("this render traces"), "{}", r.stderr);
 }
 
 #[test]
@@ -452,6 +506,97 @@ fn inputs_that_are_not_regular_files_are_refused_at_once() {
     let r = run(&dir, &["render", "mtl.test", "-o", "out.png"], seconds(20));
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     says(&r, "cannot read the MTL material library (not a regular file (a FIFO))");
+}
+
+/// State files are inputs like any other: `merge` and `--resume` read only regular files
+/// (before, a FIFO hung them and `/dev/zero` grew them until the machine stopped them),
+/// take the states' films from the memory budget, and never write over a state.
+#[test]
+fn state_files_are_read_as_inputs_and_never_overwritten() {
+    let dir = workdir("states");
+    mkfifo(&dir.join("fifo.lstate"));
+    fs::write(
+        dir.join("s.test"),
+        "size 32 24\ncamera 0 0 5 0 0 0 0 1 0 45\nintegrator pathtracer\nspp 4\nsphere 0 0 0 1\n",
+    )
+    .unwrap();
+    let render = |args: &[&str]| {
+        let r = run(&dir, args, seconds(30));
+        assert_eq!(r.code, Some(0), "{args:?}: {}", r.stderr);
+    };
+    render(&[
+        "render", "s.test", "-o", "a.png", "--spp", "2", "--state", "a.lstate", "-q",
+    ]);
+    let a = fs::read(dir.join("a.lstate")).unwrap();
+    for (args, message) in [
+        (
+            vec!["merge", "fifo.lstate", "-o", "m.png"],
+            "not a regular file (a FIFO)",
+        ),
+        (
+            vec!["merge", "/dev/zero", "-o", "m.png"],
+            "not a regular file (a character device)",
+        ),
+        (
+            vec!["render", "s.test", "-o", "r.png", "--resume", "fifo.lstate"],
+            "not a regular file (a FIFO)",
+        ),
+        (
+            vec!["render", "s.test", "-o", "r.png", "--resume", "/dev/zero"],
+            "not a regular file (a character device)",
+        ),
+        (
+            vec!["merge", "a.lstate", "-o", "m.png", "--memory-limit", "1K"],
+            "a.lstate: the state file and its film needs about 100 kB, more than the 1 kB left",
+        ),
+        (
+            vec![
+                "render",
+                "s.test",
+                "-o",
+                "r.png",
+                "--resume",
+                "a.lstate",
+                "--memory-limit",
+                "5K",
+            ],
+            "the state file and its film needs",
+        ),
+        (
+            vec!["merge", "a.lstate", "-o", "m.png", "--state", "a.lstate"],
+            "cannot write a.lstate: it is one of this run's inputs",
+        ),
+    ] {
+        let r = run(&dir, &args, seconds(20));
+        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
+        says(&r, message);
+    }
+    assert_eq!(fs::read(dir.join("a.lstate")).unwrap(), a, "an input is never replaced");
+    assert!(!dir.join("m.png").exists() && !dir.join("r.png").exists());
+    // Two one-pixel states at the far corners of an 8192 x 8192 image: a gap, said at
+    // once (before, their merge made the film of all 67 million pixels: 3 GB, 5 s).
+    for (name, bounds) in [("c1", ["0", "1", "0", "1"]), ("c2", ["8191", "8192", "8191", "8192"])] {
+        let mut args = vec!["render", "s.test", "--size", "8192", "8192", "--spp", "1", "-o"];
+        let (png, state) = (format!("{name}.png"), format!("{name}.lstate"));
+        args.extend([png.as_str(), "--state", state.as_str(), "-q", "--pixel-bounds"]);
+        args.extend(bounds);
+        render(&args);
+    }
+    let r = run(
+        &dir,
+        &[
+            "merge",
+            "c1.lstate",
+            "c2.lstate",
+            "-o",
+            "m.png",
+            "--memory-limit",
+            "100M",
+        ],
+        seconds(20),
+    );
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    says(&r, "a gap: pixel (1, 0) has 0 of the samples 0..0");
 }
 
 // ---- 5. memory ----

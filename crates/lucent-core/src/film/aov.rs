@@ -37,7 +37,7 @@ impl AovSum {
         self.albedo.add_sample(s.albedo);
         self.normal.add_sample(s.normal);
         if let Some(d) = s.depth {
-            self.depth += ExactSum::fixed(d);
+            self.depth = self.depth.wrapping_add(ExactSum::fixed(d));
             self.hits += 1;
         }
     }
@@ -46,7 +46,7 @@ impl AovSum {
     pub fn add(&mut self, other: &AovSum) {
         self.albedo.add(&other.albedo);
         self.normal.add(&other.normal);
-        self.depth += other.depth;
+        self.depth = self.depth.wrapping_add(other.depth);
         self.hits += other.hits;
     }
 }

@@ -9,6 +9,9 @@ use crate::math::{Color, DVec3};
 /// A sample's f32 value is converted exactly when it is at least 2⁻⁴¹ (below, it is
 /// rounded to a multiple of 2⁻⁶⁴, the same way every time) and clamped to ±2⁴⁰ (10¹², a
 /// radiance no scene makes), so that even 2²³ samples at that clamp cannot overflow.
+/// Additions wrap (they are exact modulo 2¹²⁸, which is still associative): parts whose
+/// sums overflow on the way (states read from files) still add up to the exact total,
+/// and nothing panics.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct ExactSum(pub [i128; 3]);
 
@@ -101,17 +104,24 @@ impl ExactSum {
         if c == Color::ZERO {
             return;
         }
-        self.0[0] += Self::fixed(c.x);
-        self.0[1] += Self::fixed(c.y);
-        self.0[2] += Self::fixed(c.z);
+        self.0[0] = self.0[0].wrapping_add(Self::fixed(c.x));
+        self.0[1] = self.0[1].wrapping_add(Self::fixed(c.y));
+        self.0[2] = self.0[2].wrapping_add(Self::fixed(c.z));
     }
 
     /// Adds another sum (of other samples of the same pixel).
     #[inline]
     pub fn add(&mut self, other: &ExactSum) {
         for k in 0..3 {
-            self.0[k] += other.0[k];
+            self.0[k] = self.0[k].wrapping_add(other.0[k]);
         }
+    }
+
+    /// Whether the sum could be that of `count` samples: no channel beyond `count` times
+    /// the clamp.
+    pub fn within(&self, count: u32) -> bool {
+        let most = (count as i128).saturating_mul(LIMIT_FIXED);
+        self.0.iter().all(|&v| v >= -most && v <= most)
     }
 
     /// The sum as f64 (rounded once, to nearest).
@@ -153,6 +163,23 @@ mod tests {
         // Huge values are clamped, not wrapped.
         let big = sum_of(&[Color::splat(f32::MAX), Color::splat(f32::MAX)]);
         assert_eq!(big.value().x, 2.0 * LIMIT);
+    }
+
+    #[test]
+    fn parts_that_overflow_on_the_way_still_add_up_to_the_total() {
+        // Two parts beyond i128 on their own (as a state file could hold), whose total fits.
+        let big = ExactSum([i128::MAX - 5, i128::MIN + 7, 1 << 100]);
+        let back = ExactSum([-(i128::MAX - 9), i128::MAX, -(1 << 100)]);
+        let (mut a, mut b) = (big, back);
+        a.add(&ExactSum([10, -10, 0]));
+        a.add(&back);
+        b.add(&big);
+        b.add(&ExactSum([10, -10, 0]));
+        assert_eq!(a, ExactSum([14, -4, 0]));
+        assert_eq!(a, b);
+        assert!(ExactSum([LIMIT_FIXED * 3, -LIMIT_FIXED * 3, 0]).within(3));
+        assert!(!ExactSum([LIMIT_FIXED * 3 + 1, 0, 0]).within(3));
+        assert!(ExactSum::default().within(0) && !ExactSum([1, 0, 0]).within(0));
     }
 
     #[test]

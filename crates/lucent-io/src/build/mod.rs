@@ -31,7 +31,7 @@ use crate::diag::Diagnostics;
 use crate::resources::Resources;
 
 pub use settings::UNBOUNDED_DEPTH_CAP;
-pub use work::Work;
+pub use work::{warn_if_absurd, Work};
 
 #[derive(Clone, Copy, Debug)]
 pub struct BuildOptions {

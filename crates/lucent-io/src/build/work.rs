@@ -1,6 +1,8 @@
 //! The work a render of the scene asks for: the rays it traces, about and at most, and
 //! the warnings when that is more than any picture needs (the settings that ask for
-//! it: `spp`, `lightsamples`, `maxdepth`, `size`).
+//! it: `spp`, `lightsamples`, `maxdepth`, `size`). The build estimates the whole picture
+//! at the scene's `spp`; a render warns about its own part of it ([`Work::of_render`],
+//! [`warn_if_absurd`]): a region, a sample range, a task, another `--spp`.
 //!
 //! "At most" follows from the settings and the materials alone (every glass hit
 //! splitting, every path going to its last bounce). "About" is measured where that is
@@ -34,6 +36,25 @@ pub struct Work {
     /// The deepest bounce traced: `maxdepth`, or less where adaptive depth control stops
     /// the branches first.
     pub depth: u32,
+    /// The samples per pixel these figures are for.
+    pub spp: f64,
+    /// Shadow rays per shading point (what `lightsamples` weighs in the warning).
+    pub shadow: f64,
+}
+
+impl Work {
+    /// The work of a render of this scene of `pixels` pixels with `samples` samples each:
+    /// a region, a sample range, another `--spp`.
+    pub fn of_render(&self, pixels: u64, samples: u32) -> Work {
+        let per_pixel = |v: f64| v / self.spp * samples as f64;
+        Work {
+            rays_per_pixel: per_pixel(self.rays_per_pixel),
+            rays: per_pixel(self.rays_per_pixel) * pixels as f64,
+            most_rays_per_pixel: per_pixel(self.most_rays_per_pixel),
+            spp: samples as f64,
+            ..*self
+        }
+    }
 }
 
 /// Work beyond either is reported: hours of rays (about 3 hours at 1 Mray/s per core on
@@ -110,8 +131,9 @@ pub fn estimate_work(
         rays: spp * per_sample * pixels as f64,
         most_rays_per_pixel: spp * most,
         depth,
+        spp,
+        shadow,
     };
-    warn_if_absurd(desc, &work, spp, shadow, depth, diags);
     if let Some((w, tree)) = whitted_tree {
         warn_if_cut(desc, scene, w, tree, diags);
     }
@@ -247,15 +269,19 @@ fn whitted_rays(scene: &Scene, whitted: &Whitted, tree: f64) -> (f64, f64, f64, 
     (per_sample, most, shadow, depth)
 }
 
-fn warn_if_absurd(desc: &SceneDesc, work: &Work, spp: f64, shadow: f64, depth: u32, diags: &mut Diagnostics) {
+/// Warns, at the setting that asks for most of it, when `work` (the build's, or
+/// [`Work::of_render`]'s for a part of the picture) is more than any picture needs.
+pub fn warn_if_absurd(desc: &SceneDesc, work: &Work, diags: &mut Diagnostics) {
     if work.rays > ABSURD_RAYS || work.rays_per_pixel > ABSURD_RAYS_PER_PIXEL {
-        let (loc, what) = culprit(desc, spp, shadow, depth);
+        let (loc, what) = culprit(desc, work.spp, work.shadow, work.depth);
         diags.warning(
             loc,
             format!(
-                "{what}: this render traces about {:.1e} rays ({:.1e} per pixel){}; Ctrl-C stops it",
+                "{what}: this render traces about {:.1e} rays ({:.1e} per pixel, {} {} each){}; Ctrl-C stops it",
                 work.rays,
                 work.rays_per_pixel,
+                work.spp,
+                if work.spp == 1.0 { "sample" } else { "samples" },
                 if work.rays > ABSURD_RAYS {
                     ", hours of work"
                 } else {
