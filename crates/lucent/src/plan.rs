@@ -78,7 +78,11 @@ pub fn apply(
         return Ok(Planned::Render);
     };
     if let (Some(path), None) = (plan_file, planning) {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("--plan {}: {e}", path.display()))?;
+        // Read as every input is: a regular file of a bounded size.
+        let limit = lucent_io::resources::input::MAX_SMALL_FILE_BYTES;
+        let text = lucent_io::resources::read_input(path, limit, &mut lucent_io::resources::Inputs::default())
+            .and_then(|b| String::from_utf8(b).map_err(|_| "not a plan (not text)".to_string()))
+            .map_err(|e| format!("--plan {}: {e}", path.display()))?;
         let (pixels, samples) =
             task_from_json(&text, job, i, n).map_err(|e| format!("--plan {}: {e}", path.display()))?;
         job.pixels = pixels;

@@ -297,15 +297,27 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
             named.record(FileId::of(&meta), p);
         }
     }
-    if let Some(r) = &args.resume {
+    for r in args.resume.iter().chain(&args.plan) {
         if let Ok(meta) = std::fs::metadata(r) {
             named.record(FileId::of(&meta), r);
         }
     }
+    // (`lucent plan --json`: its plan is an output too.)
+    let plan_json = match planning.and_then(|p| p.json.as_ref()) {
+        Some(p) => match OutputTarget::resolve(p) {
+            Ok(t) => Some((p.clone(), t)),
+            Err(e) => {
+                eprintln!("lucent: error: --json: cannot write {}: {e}", p.display());
+                return EXIT_BAD_INPUT;
+            }
+        },
+        None => None,
+    };
     let targets = std::iter::once((&out.name, &out.target))
         .chain(spp_map.iter().map(|m| (&m.name, &m.target)))
         .chain(aov_side.iter().map(|m| (&m.name, &m.target)))
-        .chain(state_out.iter().map(|(n, t)| (n, t)));
+        .chain(state_out.iter().map(|(n, t)| (n, t)))
+        .chain(plan_json.iter().map(|(n, t)| (n, t)));
     for (name, target) in targets {
         if let Err(e) = target.check_not_input(&named) {
             report(&session.diags, &session.desc.sources, false);

@@ -508,11 +508,12 @@ fn inputs_that_are_not_regular_files_are_refused_at_once() {
     says(&r, "cannot read the MTL material library (not a regular file (a FIFO))");
 }
 
-/// State files are inputs like any other: `merge` and `--resume` read only regular files
-/// (before, a FIFO hung them and `/dev/zero` grew them until the machine stopped them),
-/// take the states' films from the memory budget, and never write over a state.
+/// State files and plans are inputs like any other: `merge`, `--resume` and `--plan`
+/// read only regular files (before, a FIFO hung them and `/dev/zero` grew them until the
+/// machine stopped them), the states' films come from the memory budget, and no output
+/// replaces a state, a plan or the scene (`lucent plan --json` wrote over it).
 #[test]
-fn state_files_are_read_as_inputs_and_never_overwritten() {
+fn state_files_and_plans_are_read_as_inputs_and_never_overwritten() {
     let dir = workdir("states");
     mkfifo(&dir.join("fifo.lstate"));
     fs::write(
@@ -566,12 +567,51 @@ fn state_files_are_read_as_inputs_and_never_overwritten() {
             vec!["merge", "a.lstate", "-o", "m.png", "--state", "a.lstate"],
             "cannot write a.lstate: it is one of this run's inputs",
         ),
+        (
+            vec!["plan", "s.test", "--tasks", "2", "--json", "s.test"],
+            "cannot write s.test: it is one of this run's inputs",
+        ),
+        (
+            vec![
+                "render",
+                "s.test",
+                "--task",
+                "0/2",
+                "--plan",
+                "fifo.lstate",
+                "--state",
+                "t.lstate",
+            ],
+            "--plan fifo.lstate: not a regular file (a FIFO)",
+        ),
+        (
+            vec![
+                "render",
+                "s.test",
+                "--task",
+                "0/2",
+                "--plan",
+                "/dev/zero",
+                "--state",
+                "t.lstate",
+            ],
+            "--plan /dev/zero: not a regular file (a character device)",
+        ),
+        (
+            vec![
+                "render", "s.test", "--task", "0/2", "--plan", "a.lstate", "--state", "a.lstate",
+            ],
+            "cannot write a.lstate: it is one of this run's inputs",
+        ),
     ] {
         let r = run(&dir, &args, seconds(20));
         assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
         says(&r, message);
     }
     assert_eq!(fs::read(dir.join("a.lstate")).unwrap(), a, "an input is never replaced");
+    assert!(fs::read_to_string(dir.join("s.test"))
+        .unwrap()
+        .starts_with("size 32 24"));
     assert!(!dir.join("m.png").exists() && !dir.join("r.png").exists());
     // Two one-pixel states at the far corners of an 8192 x 8192 image: a gap, said at
     // once (before, their merge made the film of all 67 million pixels: 3 GB, 5 s).
