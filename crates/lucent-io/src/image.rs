@@ -6,6 +6,7 @@ use std::path::Path;
 
 use image::ImageEncoder;
 
+use crate::cse167::MAX_PIXELS;
 use crate::resources::{input::MAX_IMAGE_BYTES, read_input, Inputs};
 
 /// Encodes 8-bit RGB (interleaved, top row first) as PNG.
@@ -144,13 +145,33 @@ pub struct Rgb8Image {
     pub data: Vec<u8>,
 }
 
+/// The image in `path` (a regular file), no larger than a picture lucent renders
+/// ([`MAX_PIXELS`]: a 20000 × 20000 PNG of a few hundred kilobytes would otherwise take
+/// gigabytes), the decoder held to its size.
+fn decode_bounded(path: &Path) -> Result<image::DynamicImage, String> {
+    use image::ImageDecoder;
+    let bytes = read_input(path, MAX_IMAGE_BYTES, &mut Inputs::default())?;
+    let decoder = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| e.to_string())?
+        .into_decoder()
+        .map_err(|e| e.to_string())?;
+    let (w, h) = decoder.dimensions();
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(format!(
+            "the image is {w} x {h}, more than lucent compares (at most {MAX_PIXELS} pixels, as it renders)"
+        ));
+    }
+    let mut limits = image::Limits::default();
+    limits.max_alloc = Some(decoder.total_bytes() + (1 << 20));
+    let mut decoder = decoder;
+    decoder.set_limits(limits).map_err(|e| e.to_string())?;
+    image::DynamicImage::from_decoder(decoder).map_err(|e| e.to_string())
+}
+
 /// Reads a PNG or JPEG file (a regular file) as 8-bit RGB; the error says why not.
 pub fn read_rgb8(path: &Path) -> Result<Rgb8Image, String> {
-    let bytes = read_input(path, MAX_IMAGE_BYTES, &mut Inputs::default())?;
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
-    let img = reader.decode().map_err(|e| e.to_string())?.to_rgb8();
+    let img = decode_bounded(path)?.to_rgb8();
     Ok(Rgb8Image {
         width: img.width(),
         height: img.height(),
@@ -167,11 +188,7 @@ pub struct RgbF32Image {
 
 /// Reads an EXR or HDR file (a regular file) as linear RGB floats.
 pub fn read_rgb_f32(path: &Path) -> Result<RgbF32Image, String> {
-    let bytes = read_input(path, MAX_IMAGE_BYTES, &mut Inputs::default())?;
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| e.to_string())?;
-    let img = reader.decode().map_err(|e| e.to_string())?.to_rgb32f();
+    let img = decode_bounded(path)?.to_rgb32f();
     Ok(RgbF32Image {
         width: img.width(),
         height: img.height(),

@@ -129,6 +129,9 @@ thread_local! {
         .map(std::sync::Arc::new);
 }
 
+/// The most worker threads a run starts (`--threads`, `RAYON_NUM_THREADS`).
+pub const MAX_THREADS: usize = 4096;
+
 /// Worker threads that render jobs.
 pub struct Renderer {
     pool: rayon::ThreadPool,
@@ -136,9 +139,17 @@ pub struct Renderer {
 
 impl Renderer {
     /// `threads` workers, or one per core.
+    /// `threads` workers; by default rayon's choice (every core, or `RAYON_NUM_THREADS`),
+    /// held to [`MAX_THREADS`] as `--threads` is.
     pub fn new(threads: Option<usize>) -> Result<Renderer, String> {
+        let from_env = || {
+            std::env::var("RAYON_NUM_THREADS")
+                .ok()
+                .and_then(|v| v.trim().parse::<usize>().ok())
+                .map_or(0, |n| n.min(MAX_THREADS))
+        };
         rayon::ThreadPoolBuilder::new()
-            .num_threads(threads.unwrap_or(0))
+            .num_threads(threads.unwrap_or_else(from_env).min(MAX_THREADS))
             .build()
             .map(|pool| Renderer { pool })
             .map_err(|e| format!("cannot start worker threads: {e}"))

@@ -36,6 +36,7 @@ use std::path::Path;
 use lucent_core::film::{AovSum, ExactSum, Film, PixelNoise};
 use lucent_core::render::job::PixelRect;
 
+use crate::cse167::MAX_PIXELS;
 use crate::fnv::{fnv1a, START as FNV_START};
 use crate::resources::{io_reason, read_input, Budget, Inputs};
 
@@ -244,6 +245,12 @@ impl RenderState {
             return Err("the header's samples are not a range within its spp".into());
         }
         // (As the scene and the command line take them.)
+        if resolution.0 as u64 * resolution.1 as u64 > MAX_PIXELS {
+            return Err(format!(
+                "the header's resolution {} x {} is more than lucent renders",
+                resolution.0, resolution.1
+            ));
+        }
         if !(gamma > 0.0 && gamma.is_finite()) {
             return Err(format!("the header's gamma {gamma} is not a number > 0"));
         }
@@ -289,9 +296,12 @@ impl RenderState {
             let i = |j: usize| i128::from_le_bytes(px[16 * j..16 * j + 16].try_into().unwrap());
             let u = |at: usize| u32::from_le_bytes(px[at..at + 4].try_into().unwrap());
             let (sum, count) = (ExactSum([i(0), i(1), i(2)]), u(48));
-            // What no render makes: more samples than the file's range holds, or a sum
-            // beyond what its samples can add up to (each is clamped: ExactSum).
-            if count > header.samples.len() as u32 || !sum.within(count) {
+            // What no render makes: other than every sample of the file's range (fewer
+            // only where adaptive sampling stopped the pixel), or a sum beyond what its
+            // samples can add up to (each is clamped: ExactSum).
+            let all = header.samples.len() as u32;
+            let adaptive = header.noise_threshold.is_some();
+            if count > all || (count < all && !adaptive) || !sum.within(count) {
                 return Err(damaged());
             }
             film.sums_mut()[k] = sum;
@@ -626,6 +636,15 @@ mod tests {
         s.film.counts[1] = 5;
         let e = RenderState::decode(&s.encode()).unwrap_err();
         assert!(e.contains("not what a state file holds"), "{e}");
+        // Fewer samples than the range, where no adaptive sampling stopped the pixel.
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.film.counts[2] = 3;
+        let e = RenderState::decode(&s.encode()).unwrap_err();
+        assert!(e.contains("not what a state file holds"), "{e}");
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.header.resolution = (u32::MAX, u32::MAX);
+        let e = RenderState::decode(&s.encode()).unwrap_err();
+        assert!(e.contains("more than lucent renders"), "{e}");
         let mut s = state(rect(0, 2, 0, 2), 4..8);
         s.film.sums_mut()[3].0[2] = i128::MAX;
         let e = RenderState::decode(&s.encode()).unwrap_err();

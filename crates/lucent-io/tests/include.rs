@@ -56,3 +56,19 @@ fn include_errors_point_into_the_right_file_and_name_the_cycle() {
         "{d}"
     );
 }
+
+/// 31 files of 22 bytes, each including the next twice, would include 2³¹ files (before
+/// the cap, `check` ran 11 minutes into 6.5 GB): the inclusions stop at 10,000, at once.
+#[test]
+fn inclusions_that_double_at_every_level_stop_at_the_cap() {
+    let dir = TempDir::new("include-doubling");
+    for i in 1..=31 {
+        dir.write(&format!("{i}"), &format!("include {}\ninclude {}\n", i + 1, i + 1));
+    }
+    dir.write("32", "");
+    let text = "size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\ninclude 1\n";
+    let session = lucent_io::session::Session::parse_text(&dir.scene(), text.as_bytes(), Default::default());
+    let d = session.diags.render(&session.desc.sources);
+    assert!(d.contains("error: include: more than 10000 inclusions in all"), "{d}");
+    assert!(session.desc.included.len() <= 10_000);
+}

@@ -19,6 +19,7 @@ mod progress;
 mod render;
 mod settings_args;
 mod signals;
+mod targets;
 
 use std::process::ExitCode;
 

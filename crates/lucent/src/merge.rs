@@ -5,7 +5,7 @@
 //! every input is (regular files only), their films and the picture come out of a
 //! memory budget, and no output may replace one of the inputs.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 use lucent_io::desc::SceneDesc;
@@ -14,9 +14,10 @@ use lucent_io::resources::{Budget, Inputs, OutputTarget};
 use lucent_io::state::{merge, read_state};
 
 use crate::aov_args::{parse_aovs, AovSelection};
-use crate::output::choose_output;
-use crate::picture::{aov_file, image_bytes, write_picture, Extras};
+use crate::output::{choose_output, write_all, Encoded};
+use crate::picture::{aov_file, encode_picture, image_bytes, Extras};
 use crate::render::parse_size;
+use crate::targets::check_targets;
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
@@ -121,24 +122,27 @@ pub fn run(args: &MergeArgs) -> u8 {
     };
     // No output may replace an input: the states stay as they were, so that a merge of
     // the wrong list can be made again.
-    let targets = std::iter::once((&out.name, &out.target))
-        .chain(aov_side.iter().map(|a| (&a.name, &a.target)))
-        .chain(args.state.iter().zip(&state_out));
-    for (name, target) in targets {
-        if let Err(e) = target.check_not_input(&inputs) {
-            eprintln!("lucent: error: cannot write {}: {e}", name.display());
-            return EXIT_BAD_INPUT;
-        }
-    }
-    if let Err(e) = write_picture(&out, &merged.film, &merged.header, &extras) {
+    let mut targets: Vec<(&Path, &OutputTarget)> = vec![(&out.name, &out.target)];
+    targets.extend(aov_side.iter().map(|a| (a.name.as_path(), &a.target)));
+    targets.extend(args.state.iter().map(|p| p.as_path()).zip(&state_out));
+    if let Err(e) = check_targets(&targets, &inputs) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
-    if let (Some(path), Some(target)) = (&args.state, &state_out) {
-        if let Err(e) = target.write(&merged.encode()) {
-            eprintln!("lucent: error: cannot write {}: {e}", path.display());
-            return EXIT_BAD_INPUT;
+    // Every output or none.
+    let written = encode_picture(&out, &merged.film, &merged.header, &extras).and_then(|mut files| {
+        if let (Some(path), Some(target)) = (&args.state, &state_out) {
+            files.push(Encoded {
+                name: path.clone(),
+                target: target.clone(),
+                bytes: merged.encode(),
+            });
         }
+        write_all(&files)
+    });
+    if let Err(e) = written {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
     }
     0
 }

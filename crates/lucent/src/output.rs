@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use lucent_io::desc::SceneDesc;
 use lucent_io::diag::{Diagnostics, Loc, Severity, SourceMap};
 use lucent_io::image::{encode_exr, encode_hdr, encode_jpeg, encode_png, ImageInfo};
-use lucent_io::resources::OutputTarget;
+use lucent_io::resources::{write_together, OutputTarget};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
@@ -60,9 +60,16 @@ pub fn choose_output(cli: Option<&Path>, desc: &SceneDesc, diags: &mut Diagnosti
     Ok(Output { name, format, target })
 }
 
-/// Encodes the film in the output's format and writes it (atomically for a file); PNG
-/// and EXR files carry `info`'s text (and an EXR its place in the whole picture).
-pub fn write_image(out: &Output, film: &lucent_core::image::Image, info: &ImageInfo) -> Result<(), String> {
+/// An output's bytes, made before anything is written ([`write_all`]).
+pub struct Encoded {
+    pub name: PathBuf,
+    pub target: OutputTarget,
+    pub bytes: Vec<u8>,
+}
+
+/// The image in the output's format; PNG and EXR files carry `info`'s text (and an EXR
+/// its place in the whole picture).
+pub fn encode_image(out: &Output, film: &lucent_core::image::Image, info: &ImageInfo) -> Result<Encoded, String> {
     let (w, h) = (film.width, film.height);
     let gamma = info.gamma;
     let bytes = match out.format {
@@ -71,9 +78,19 @@ pub fn write_image(out: &Output, film: &lucent_core::image::Image, info: &ImageI
         Format::Jpeg => encode_jpeg(w, h, &film.to_rgb8(gamma)),
         Format::Png => encode_png(w, h, &film.to_rgb8(gamma), info),
     };
-    bytes
-        .and_then(|b| out.target.write(&b))
-        .map_err(|e| format!("cannot write {}: {e}", out.name.display()))
+    let bytes = bytes.map_err(|e| format!("cannot write {}: {e}", out.name.display()))?;
+    Ok(Encoded {
+        name: out.name.clone(),
+        target: out.target.clone(),
+        bytes,
+    })
+}
+
+/// Writes a run's outputs together ([`write_together`]): where one fails, no file is
+/// replaced.
+pub fn write_all(files: &[Encoded]) -> Result<(), String> {
+    let list: Vec<(&OutputTarget, &[u8])> = files.iter().map(|f| (&f.target, &f.bytes[..])).collect();
+    write_together(&list).map_err(|(i, e)| format!("cannot write {}: {e}", files[i].name.display()))
 }
 
 /// Prints errors and warnings to stderr, and notes too when `notes` is set (`check`

@@ -8,7 +8,7 @@ use lucent_core::film::Film;
 use lucent_io::resources::OutputTarget;
 use lucent_io::state::{RenderState, StateHeader};
 
-use crate::output::Output;
+use crate::output::{write_all, Encoded, Output};
 use crate::picture::Extras;
 
 /// Where a partial render goes: `OUT.partial.EXT` beside the output (nothing for standard
@@ -47,6 +47,15 @@ impl Partial {
         Partial { image, state }
     }
 
+    /// Where the partial results would go (the names that can be written).
+    pub fn targets(&self) -> Vec<(PathBuf, OutputTarget)> {
+        let state = OutputTarget::resolve(&self.state.0)
+            .ok()
+            .map(|t| (self.state.0.clone(), t));
+        let image = self.image.as_ref().map(|o| (o.name.clone(), o.target.clone()));
+        image.into_iter().chain(state).collect()
+    }
+
     pub fn image_name(&self) -> String {
         self.image
             .as_ref()
@@ -60,16 +69,22 @@ impl Partial {
     /// Writes the partial image (with the passes and denoising of `extras`) and the
     /// state (each atomically).
     pub fn write(&self, film: &Film, header: StateHeader, extras: &Extras) -> Result<(), String> {
-        if let Some(img) = &self.image {
-            crate::picture::write_picture(img, film, &header, extras)?;
-        }
+        let mut files = match &self.image {
+            Some(img) => crate::picture::encode_picture(img, film, &header, extras)?,
+            None => Vec::new(),
+        };
+        let target = OutputTarget::resolve(&self.state.0)
+            .map_err(|e| format!("cannot write {}: {e}", self.state.0.display()))?;
         let state = RenderState {
             header,
             film: film.clone(),
         };
-        OutputTarget::resolve(&self.state.0)
-            .and_then(|t| t.write(&state.encode()))
-            .map_err(|e| format!("cannot write {}: {e}", self.state.0.display()))
+        files.push(Encoded {
+            name: self.state.0.clone(),
+            target,
+            bytes: state.encode(),
+        });
+        write_all(&files)
     }
 
     /// Removes what checkpoints wrote, once the render is complete (the state at

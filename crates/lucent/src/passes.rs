@@ -60,7 +60,7 @@ pub fn render_in_passes(
     let mut done = job.samples.start;
     let mut size = 1;
     while done < job.samples.end {
-        let pass = done..(done + size).min(job.samples.end);
+        let pass = done..done.saturating_add(size).min(job.samples.end);
         let pass_job = RenderJob {
             samples: pass.clone(),
             ..job.clone()

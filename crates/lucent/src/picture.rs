@@ -17,7 +17,7 @@ use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::state::StateHeader;
 
 use crate::aov_args::AovSelection;
-use crate::output::{choose_output, image_info, write_image, Format, Output};
+use crate::output::{choose_output, encode_image, image_info, Encoded, Format, Output};
 
 /// What is written besides the plain colour.
 #[derive(Clone, Copy)]
@@ -54,7 +54,7 @@ pub fn picture_bytes(job: &RenderJob, resumed: bool, extras: &Extras) -> u64 {
     films + image_bytes(pixels, aovs, extras)
 }
 
-/// What [`write_picture`] makes of a film of `pixels` pixels: the colour as floats and as
+/// What [`encode_picture`] makes of a film of `pixels` pixels: the colour as floats and as
 /// written, each auxiliary pass as floats (up to four, where the film keeps them:
 /// `aovs`), and the denoiser's buffers.
 pub fn image_bytes(pixels: u64, aovs: bool, extras: &Extras) -> u64 {
@@ -111,8 +111,14 @@ pub fn aov_file(out: &Output, aovs: AovSelection) -> Result<Option<Output>, Stri
     .map(Some)
 }
 
-/// Writes the picture of `film` (described by `header`) to `out`, with `extras`.
-pub fn write_picture(out: &Output, film: &Film, header: &StateHeader, extras: &Extras) -> Result<(), String> {
+/// The files of the picture of `film` (described by `header`) at `out`, with `extras`:
+/// the image, and the passes' EXR beside it.
+pub fn encode_picture(
+    out: &Output,
+    film: &Film,
+    header: &StateHeader,
+    extras: &Extras,
+) -> Result<Vec<Encoded>, String> {
     let info = image_info(header);
     let noisy = film.resolve();
     let aovs = film.resolve_aovs();
@@ -124,27 +130,29 @@ pub fn write_picture(out: &Output, film: &Film, header: &StateHeader, extras: &E
         None => None,
     };
     let colour = denoised.as_ref().unwrap_or(&noisy);
-    let layered = |colour: &Image| {
+    let layered = |at: &Output| {
         let noisy = denoised.is_some().then_some(&noisy);
-        encode_exr_channels(
+        let bytes = encode_exr_channels(
             film.width,
             film.height,
             channels(colour, noisy, aovs.as_ref(), extras.aovs),
             &info,
         )
+        .map_err(|e| format!("cannot write {}: {e}", at.name.display()))?;
+        Ok::<_, String>(Encoded {
+            name: at.name.clone(),
+            target: at.target.clone(),
+            bytes,
+        })
     };
     if out.format == Format::Exr {
-        return layered(colour)
-            .and_then(|b| out.target.write(&b))
-            .map_err(|e| format!("cannot write {}: {e}", out.name.display()));
+        return Ok(vec![layered(out)?]);
     }
-    write_image(out, colour, &info)?;
+    let mut files = vec![encode_image(out, colour, &info)?];
     if let Some(side) = aov_file(out, extras.aovs)? {
-        layered(colour)
-            .and_then(|b| side.target.write(&b))
-            .map_err(|e| format!("cannot write {}: {e}", side.name.display()))?;
+        files.push(layered(&side)?);
     }
-    Ok(())
+    Ok(files)
 }
 
 /// The colour through Open Image Denoise, guided by the albedo and normal passes.

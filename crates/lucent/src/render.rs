@@ -4,7 +4,7 @@
 //! state file gives exactly the pixels of the one-go render: merged (`lucent merge`) the
 //! parts are its bytes.`
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
@@ -26,14 +26,15 @@ use lucent_io::state::{RenderState, StateHeader};
 
 use crate::aov_args::{parse_aovs, AovSelection};
 use crate::job_args::{apply_samples, parse_samples, pixel_rect, resume};
-use crate::output::{choose_output, report};
+use crate::output::{choose_output, encode_image, report, write_all, Encoded};
 use crate::partial::Partial;
 use crate::passes::{render_in_passes, Outcome};
-use crate::picture::{aov_file, picture_bytes, take_picture_memory, write_picture, Extras};
+use crate::picture::{aov_file, encode_picture, picture_bytes, take_picture_memory, Extras};
 use crate::plan::{PlanRequest, Planned};
 use crate::progress::{Finish, Progress};
 use crate::settings_args::{overrides, quick};
 use crate::signals;
+use crate::targets::check_targets;
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
@@ -157,11 +158,11 @@ fn parse_threshold(s: &str) -> Result<f32, String> {
     }
 }
 
-/// `--checkpoint`: seconds, a finite number > 0.
+/// `--checkpoint`: seconds, a number > 0 and at most 10⁹ (some 30 years).
 fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
-        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
-        _ => Err(format!("'{s}' is not a number of seconds > 0")),
+        Ok(v) if v > 0.0 && v <= 1e9 => Ok(v),
+        _ => Err(format!("'{s}' is not a number of seconds > 0 (and at most 1e9)")),
     }
 }
 
@@ -291,15 +292,17 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
             return EXIT_BAD_INPUT;
         }
     };
+    // The run's inputs so far: what the scene read and names, and every scene of the
+    // run (one scene's output must not replace the next one).
     let mut named = session.res.inputs.clone();
-    for p in session.desc.named_files() {
+    for p in session
+        .desc
+        .named_files()
+        .into_iter()
+        .chain(args.scenes.iter().map(|s| s.as_path()))
+    {
         if let Ok(meta) = std::fs::metadata(p) {
             named.record(FileId::of(&meta), p);
-        }
-    }
-    for r in args.resume.iter().chain(&args.plan) {
-        if let Ok(meta) = std::fs::metadata(r) {
-            named.record(FileId::of(&meta), r);
         }
     }
     // (`lucent plan --json`: its plan is an output too.)
@@ -313,17 +316,28 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         },
         None => None,
     };
-    let targets = std::iter::once((&out.name, &out.target))
-        .chain(spp_map.iter().map(|m| (&m.name, &m.target)))
-        .chain(aov_side.iter().map(|m| (&m.name, &m.target)))
-        .chain(state_out.iter().map(|(n, t)| (n, t)))
-        .chain(plan_json.iter().map(|(n, t)| (n, t)));
-    for (name, target) in targets {
-        if let Err(e) = target.check_not_input(&named) {
-            report(&session.diags, &session.desc.sources, false);
-            eprintln!("lucent: error: cannot write {}: {e}", name.display());
-            return EXIT_BAD_INPUT;
+    // Partial results (a checkpoint, or what an interrupt leaves) go beside the output,
+    // never over it: OUT.partial.png and, without --state, OUT.partial.lstate. They may
+    // replace the state resumed from (they hold its samples), no other input.
+    let partial = Partial::beside(&out, &args.state, &session.desc);
+    let partial_targets = partial.targets();
+    let mut final_targets: Vec<(&Path, &OutputTarget)> = vec![(&out.name, &out.target)];
+    final_targets.extend(spp_map.iter().map(|m| (m.name.as_path(), &m.target)));
+    final_targets.extend(aov_side.iter().map(|m| (m.name.as_path(), &m.target)));
+    final_targets.extend(state_out.iter().map(|(n, t)| (n.as_path(), t)));
+    final_targets.extend(plan_json.iter().map(|(n, t)| (n.as_path(), t)));
+    let partials: Vec<(&Path, &OutputTarget)> = partial_targets.iter().map(|(n, t)| (n.as_path(), t)).collect();
+    let mut checked = check_targets(&partials, &named);
+    for r in args.resume.iter().chain(&args.plan) {
+        if let Ok(meta) = std::fs::metadata(r) {
+            named.record(FileId::of(&meta), r);
         }
+    }
+    checked = checked.and_then(|()| check_targets(&final_targets, &named));
+    if let Err(e) = checked {
+        report(&session.diags, &session.desc.sources, false);
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
     }
     let renderer = match start_renderer(args.threads) {
         Ok(r) => r,
@@ -337,6 +351,13 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     let Some(built) = &session.built else {
         return EXIT_BAD_INPUT;
     };
+    // Everything the build read (MTL libraries and their images too) is an input.
+    named.extend(&session.res.inputs);
+    let checked = check_targets(&partials, &session.res.inputs).and_then(|()| check_targets(&final_targets, &named));
+    if let Err(e) = checked {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
+    }
     let extras = Extras {
         aovs: args.aov.unwrap_or_default(),
         denoiser: denoiser.as_ref(),
@@ -458,9 +479,6 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     let progress = Progress::new(job.pixels.pixels() * job.samples.len() as u64, args.quiet);
     let cancel = signals::cancel_flag();
     let t_render = Instant::now();
-    // Partial results (a checkpoint, or what an interrupt leaves) go beside the output,
-    // never over it: OUT.partial.png and, without --state, OUT.partial.lstate.
-    let partial = Partial::beside(&out, &args.state, &session.desc);
     let first = resumed.as_ref().map_or(job.samples.start, |s| s.header.samples.start);
     let mut wrote_partial = false;
     let mut save = |film: &Film, samples: &std::ops::Range<u32>| {
@@ -555,18 +573,23 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
             stats.cut_branches,
         );
     }
-    // Everything the build read (MTL libraries and their images too) is an input.
-    if let Err(e) = out.target.check_not_input(&session.res.inputs) {
-        eprintln!("lucent: error: cannot write {}: {e}", out.name.display());
+    // Once more before writing (the inputs are the same; a file may have been linked).
+    if let Err(e) = check_targets(&final_targets, &named) {
+        eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     let writing = Progress::phase("writing", args.quiet);
     let _done_writing = Finish(&writing);
     let info = crate::output::image_info(&kept);
-    if let Err(e) = write_picture(&out, &film, &kept, &extras) {
-        eprintln!("lucent: error: {e}");
-        return EXIT_BAD_INPUT;
-    }
+    // Every output is made first, then all are written together: where one cannot be
+    // written, none replaces what was there.
+    let mut files = match encode_picture(&out, &film, &kept, &extras) {
+        Ok(f) => f,
+        Err(e) => {
+            eprintln!("lucent: error: {e}");
+            return EXIT_BAD_INPUT;
+        }
+    };
     if let Some(map) = &spp_map {
         // PNG holds fractions of the cap; the float formats hold the counts themselves.
         let scale = if map.format == crate::output::Format::Png {
@@ -583,9 +606,12 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
             gamma: 1.0,
             ..info.clone()
         };
-        if let Err(e) = crate::output::write_image(map, &counts, &linear) {
-            eprintln!("lucent: error: {e}");
-            return EXIT_BAD_INPUT;
+        match encode_image(map, &counts, &linear) {
+            Ok(f) => files.push(f),
+            Err(e) => {
+                eprintln!("lucent: error: {e}");
+                return EXIT_BAD_INPUT;
+            }
         }
     }
     if let Some((name, target)) = &state_out {
@@ -593,10 +619,15 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
             header: kept,
             film: film.clone(),
         };
-        if let Err(e) = target.write(&state.encode()) {
-            eprintln!("lucent: error: cannot write {}: {e}", name.display());
-            return EXIT_BAD_INPUT;
-        }
+        files.push(Encoded {
+            name: name.clone(),
+            target: target.clone(),
+            bytes: state.encode(),
+        });
+    }
+    if let Err(e) = write_all(&files) {
+        eprintln!("lucent: error: {e}");
+        return EXIT_BAD_INPUT;
     }
     if wrote_partial {
         partial.remove(&extras);

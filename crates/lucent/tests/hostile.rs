@@ -639,6 +639,112 @@ fn state_files_and_plans_are_read_as_inputs_and_never_overwritten() {
     says(&r, "a gap: pixel (1, 0) has 0 of the samples 0..0");
 }
 
+/// A run's outputs are checked together and written all or none: no output may replace
+/// an input of the run (another scene of it, an MTL library or its texture found while
+/// building, a ray file), two outputs may not be the same file, the partial results may
+/// not replace the scene, and where one output fails (`/dev/full`) none replaces what
+/// was there.
+#[test]
+fn outputs_are_checked_together_and_written_all_or_none() {
+    let dir = workdir("together");
+    let scene = "size 8 6\ncamera 0 0 4 0 0 0 0 1 0 45\npoint 1 1 3 1 1 1\ndiffuse 1 1 1\nsphere 0 0 0 1\n";
+    for name in ["s.test", "a.test", "a.png", "o.partial.lstate"] {
+        fs::write(dir.join(name), scene).unwrap();
+    }
+    fs::write(dir.join("m.mtl"), "newmtl m\nKd 1 1 1\nmap_Kd kd.png\n").unwrap();
+    image::RgbImage::from_raw(1, 1, vec![200, 100, 50])
+        .unwrap()
+        .save(dir.join("kd.png"))
+        .unwrap();
+    fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    fs::write(dir.join("d.test"), format!("{scene}mesh m.obj\n")).unwrap();
+    fs::write(dir.join("old.png"), b"precious").unwrap();
+    let rays: Vec<u8> = [0f32, 0.0, 5.0, 0.0, 0.0, 0.0, -1.0, 1e30]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    fs::write(dir.join("r.bin"), &rays).unwrap();
+    let before: Vec<(String, Vec<u8>)> = common::files_in(&dir)
+        .into_iter()
+        .map(|n| (n.clone(), fs::read(dir.join(&n)).unwrap()))
+        .collect();
+    for (args, message) in [
+        // a.test's output, a.png, is the next scene.
+        (
+            vec!["render", "a.test", "a.png"],
+            "cannot write a.png: it is one of this run's inputs",
+        ),
+        (
+            vec!["render", "o.partial.lstate", "-o", "o.png"],
+            "cannot write o.partial.lstate: it is one of",
+        ),
+        (
+            vec!["render", "d.test", "-o", "o.png", "--state", "m.mtl"],
+            "cannot write m.mtl: it is one of",
+        ),
+        (
+            vec!["render", "d.test", "-o", "o.png", "--spp-map", "kd.png"],
+            "cannot write kd.png: it is one of",
+        ),
+        (
+            vec!["bench", "rays", "m.obj", "r.bin", "--hits", "r.bin"],
+            "cannot write r.bin: it is one of",
+        ),
+        (
+            vec!["render", "s.test", "-o", "y.png", "--state", "y.png"],
+            "cannot write both y.png and y.png",
+        ),
+        (
+            vec!["render", "s.test", "-o", "-", "--spp-map", "-"],
+            "cannot write both - and -",
+        ),
+        (
+            vec!["render", "s.test", "-o", "old.png", "--state", "/dev/full"],
+            "cannot write /dev/full",
+        ),
+        (
+            vec!["render", "s.test", "-o", "o.png", "--checkpoint", "1e300"],
+            "at most 1e9",
+        ),
+    ] {
+        let r = run(&dir, &args, seconds(30));
+        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
+        says(&r, message);
+    }
+    for (name, bytes) in before {
+        assert_eq!(fs::read(dir.join(&name)).unwrap(), bytes, "{name} changed");
+    }
+    assert!(!dir.join("o.png").exists() && !dir.join("y.png").exists());
+    assert!(temporary_files(&dir).is_empty());
+}
+
+/// The last samples of the largest spp: the passes' ranges do not wrap past 2³² − 1.
+#[test]
+fn the_last_sample_indices_render() {
+    let dir = workdir("last-samples");
+    fs::write(
+        dir.join("p.test"),
+        "size 4 3\nintegrator pathtracer\ncamera 0 0 4 0 0 0 0 1 0 45\nquadLight -0.5 2 -0.5 0 0 1 1 0 0 5 5 5\nsphere 0 0 0 1\n",
+    )
+    .unwrap();
+    let args = [
+        "render",
+        "p.test",
+        "-o",
+        "p.png",
+        "--spp",
+        "4294967295",
+        "--samples",
+        "4294967000..4294967001",
+    ];
+    let r = run(&dir, &args, seconds(60));
+    assert_eq!(r.code, Some(0), "{}", r.stderr);
+}
+
 // ---- 5. memory ----
 
 /// A PNG whose header says 16384 × 16384 (its pixels are never read).
@@ -669,6 +775,22 @@ fn forged_png(width: u32, height: u32) -> Vec<u8> {
     chunk(&mut png, b"IDAT", &[0x78, 0x9c, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01]);
     chunk(&mut png, b"IEND", &[]);
     png
+}
+
+/// `lucent diff` compares pictures of the sizes lucent renders: a PNG whose header says
+/// 20000 x 20000 (a few hundred kilobytes of zeros would fill it) took 9.8 GB with --noise.
+#[test]
+fn diff_refuses_images_larger_than_any_render() {
+    let dir = workdir("diff-bomb");
+    fs::write(dir.join("bomb.png"), forged_png(20000, 20000)).unwrap();
+    for args in [
+        vec!["diff", "bomb.png", "bomb.png"],
+        vec!["diff", "--noise", "bomb.png", "bomb.png"],
+    ] {
+        let r = run(&dir, &args, seconds(30));
+        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
+        says(&r, "the image is 20000 x 20000, more than lucent compares");
+    }
 }
 
 #[test]

@@ -66,6 +66,7 @@ const CLI: Floors = &[
     ("job_args", 0),
     ("settings_args", 0),
     ("aov_args", 0),
+    ("targets", 0),
     ("picture", 1),
     ("partial", 2),
     ("plan", 2),

@@ -3,7 +3,8 @@
 //! everything else carry on through it). The name is relative to the folder of the file
 //! that includes it; diagnostics point into the included file. A file that includes
 //! itself, directly or through others, is refused with the chain of files; so are more
-//! than 32 levels, and more included text than one scene file may hold.
+//! than 32 levels, more than 10,000 inclusions in all (31 files that each include the
+//! next twice would include 2³¹), and more included text than one scene file may hold.
 
 use std::path::PathBuf;
 
@@ -13,11 +14,17 @@ use crate::resources::input::{read_input, Inputs, MAX_SCENE_BYTES};
 
 /// Files open inside one another at most.
 const MAX_DEPTH: usize = 32;
+/// Inclusions in all, at most (each keeps its file's lines for diagnostics).
+pub const MAX_INCLUDES: usize = 10_000;
 
 impl Parser {
     /// `include file`.
     pub(super) fn include(&mut self, c: &Command) {
         if !self.expect_count(c, 1, "a scene file") {
+            return;
+        }
+        if self.desc.included.len() >= MAX_INCLUDES {
+            self.err_arg(c, 0, format!("include: more than {MAX_INCLUDES} inclusions in all"));
             return;
         }
         let file = self.file_arg(c, 0);

@@ -65,6 +65,13 @@ impl Inputs {
         self.files.iter().find(|(f, _)| *f == id).map(|(_, p)| p.as_path())
     }
 
+    /// Records every file of `other` too.
+    pub fn extend(&mut self, other: &Inputs) {
+        for (id, path) in &other.files {
+            self.record(*id, path);
+        }
+    }
+
     pub fn paths(&self) -> impl Iterator<Item = &Path> {
         self.files.iter().map(|(_, p)| p.as_path())
     }

@@ -9,7 +9,7 @@ pub mod output;
 
 pub use budget::Budget;
 pub use input::{open_input, read_input, Inputs};
-pub use output::OutputTarget;
+pub use output::{write_together, OutputTarget};
 
 /// What loading a scene keeps track of: the files it has read and the memory it may
 /// still take.

@@ -113,6 +113,34 @@ impl OutputTarget {
     }
 }
 
+/// Writes the outputs of one run together, so that a failure leaves every file as it
+/// was: devices and standard output first (they cannot be taken back, and a FIFO nobody
+/// reads or a full device fails there), then every file to a temporary beside it; only
+/// once all are written are the temporaries renamed over their targets. The error names
+/// the output that failed (its index).
+pub fn write_together(outputs: &[(&OutputTarget, &[u8])]) -> Result<(), (usize, String)> {
+    for (i, (target, bytes)) in outputs.iter().enumerate() {
+        if !matches!(target, OutputTarget::File(_)) {
+            target.write(bytes).map_err(|e| (i, e))?;
+        }
+    }
+    let mut staged = Vec::new();
+    for (i, (target, bytes)) in outputs.iter().enumerate() {
+        if let OutputTarget::File(path) = target {
+            let tmp = TemporaryFile::create(path).map_err(|e| (i, e))?;
+            let mut file = tmp.file.as_ref().expect("just created");
+            file.write_all(bytes)
+                .and_then(|_| file.sync_all())
+                .map_err(|e| (i, io_reason(&e)))?;
+            staged.push((i, path, tmp));
+        }
+    }
+    for (i, path, tmp) in staged {
+        tmp.rename_over(path).map_err(|e| (i, e))?;
+    }
+    Ok(())
+}
+
 /// A regular file to be (re)written: its folder must take a new file.
 fn new_file(path: PathBuf) -> Result<OutputTarget, String> {
     let tmp = TemporaryFile::create(&path)?;

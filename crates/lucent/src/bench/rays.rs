@@ -27,7 +27,7 @@ use lucent_core::ray::{PreparedRay, Ray};
 use lucent_io::obj::load_obj;
 use lucent_io::resources::budget::Budget;
 use lucent_io::resources::input::MAX_MESH_BYTES;
-use lucent_io::resources::{read_input, OutputTarget, Resources};
+use lucent_io::resources::{read_input, Inputs, OutputTarget, Resources};
 use rayon::prelude::*;
 
 use crate::EXIT_BAD_INPUT;
@@ -107,8 +107,9 @@ impl PrimitiveSet for Queried {
 const RECORD: usize = 32;
 const MISS: u32 = u32::MAX;
 
-fn read_rays(path: &std::path::Path) -> Result<Vec<Ray>, String> {
-    let bytes = read_input(path, MAX_MESH_BYTES, &mut Resources::new(u64::MAX).inputs)
+/// The ray file at `path`, recorded in `inputs` (so that `--hits` cannot replace it).
+fn read_rays(path: &std::path::Path, inputs: &mut Inputs) -> Result<Vec<Ray>, String> {
+    let bytes = read_input(path, MAX_MESH_BYTES, inputs)
         .map_err(|e| format!("{}: cannot read ray file: {e}", path.display()))?;
     if bytes.len() % RECORD != 0 {
         return Err(format!(
@@ -204,7 +205,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         mesh,
         prefetch_hits: args.prefetch_hits,
     };
-    let rays = read_rays(&args.rays)?;
+    let rays = read_rays(&args.rays, &mut res.inputs)?;
 
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0) as usize)
