@@ -158,8 +158,10 @@ impl RenderState {
                 .position(|&b| b == b'\n')
                 .ok_or("not a lucent state file (its header is cut short)")?;
             pos += end + 1;
-            std::str::from_utf8(&rest[..end])
-                .map_err(|_| "not a lucent state file (its header is not text)".to_string())
+            // (A header whose lines end in CR LF, converted by some tool: read, so that
+            // its converted data is named as damaged rather than its version unknown.)
+            let text = rest[..end].strip_suffix(b"\r").unwrap_or(&rest[..end]);
+            std::str::from_utf8(text).map_err(|_| "not a lucent state file (its header is not text)".to_string())
         };
         let not_state = || format!("not a lucent state file (it does not start with '{MAGIC}')");
         // (Checked first, so that any other file is named for what it is not, not for a

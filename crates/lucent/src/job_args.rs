@@ -103,7 +103,7 @@ pub fn resume(
     };
     if let Some(what) = h.difference(&now, false) {
         let why = match what {
-            "scene" => "the scene's text has changed".to_string(),
+            "scene" => "the scene's text (or its -D, --size or --maxdepth overrides) has changed".to_string(),
             _ => format!("the {what} differs"),
         };
         return Err(format!("it is not a render of this scene with these options: {why}"));

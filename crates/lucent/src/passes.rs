@@ -66,13 +66,11 @@ pub fn render_in_passes(
             ..job.clone()
         };
         let t = Instant::now();
+        // (A pass that returns is whole, even if a signal came as it ended: it is kept.)
         let Some((f, s)) = renderer.render_after(built, &pass_job, film.as_ref(), spare.take(), progress, cancel)
         else {
             break;
         };
-        if cancel.load(Ordering::Relaxed) {
-            break;
-        }
         let took = t.elapsed().as_secs_f64();
         // (Exact sums: the first pass's film is what adding it to an empty one gives.)
         let so_far = match film.take() {
@@ -97,6 +95,9 @@ pub fn render_in_passes(
             None => stats = Some(s),
         }
         done = pass.end;
+        if cancel.load(Ordering::Relaxed) {
+            break;
+        }
         if let Some(every) = checkpoint {
             if last_save.elapsed() >= every && done < job.samples.end {
                 save(so_far, &(first..done));

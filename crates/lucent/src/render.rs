@@ -24,7 +24,7 @@ use lucent_io::resources::{Budget, OutputTarget};
 use lucent_io::session::{Renderer, Session, SessionOptions};
 use lucent_io::state::{RenderState, StateHeader};
 
-use crate::aov_args::{parse_aovs, AovSelection};
+use crate::aov_args::{parse_aovs, AovSelection, AOV_NAMES};
 use crate::job_args::{apply_samples, parse_samples, pixel_rect, resume};
 use crate::output::{choose_output, encode_image, report, write_all, Encoded};
 use crate::partial::Partial;
@@ -505,8 +505,15 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     );
     let t_rendered = Instant::now();
     progress.finish();
+    // A signal as the last pass ended: the whole render is saved as a partial one.
+    let outcome = match outcome {
+        Outcome::Done(film, _) if cancel.load(Ordering::Relaxed) => {
+            Outcome::Interrupted(Some((film, first..job.samples.end)))
+        }
+        o => o,
+    };
     let (film, stats) = match outcome {
-        Outcome::Done(film, stats) if !cancel.load(Ordering::Relaxed) => (film, stats),
+        Outcome::Done(film, stats) => (film, stats),
         Outcome::Interrupted(Some((film, samples))) => {
             signals::saving(true);
             let kept = StateHeader {
@@ -514,11 +521,7 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
                 ..header(&job)
             };
             let how = if pixel_sampling == "uniform" {
-                format!(
-                    "continue with: lucent render {} --resume {}",
-                    scene.display(),
-                    partial.state_name()
-                )
+                format!("continue with: {}", resume_command(args, scene, &partial.state_name()))
             } else {
                 format!(
                     "render the rest with --samples {}..{} --state REST.lstate and put them together with lucent merge",
@@ -681,6 +684,77 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         );
     }
     0
+}
+
+/// The command that continues this render from `state`: the scene and every option
+/// that decides its samples and outputs, as given, then `--resume`.
+fn resume_command(args: &RenderArgs, scene: &Path, state: &str) -> String {
+    // Quoted for a POSIX shell where a word needs it.
+    let quote = |w: &str| {
+        let plain = !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || "-_./,=:+@%".contains(c));
+        if plain {
+            w.to_string()
+        } else {
+            format!("'{}'", w.replace('\'', "'\\''"))
+        }
+    };
+    let mut words = vec!["lucent".to_string(), "render".into(), quote(&scene.to_string_lossy())];
+    let mut add = |option: &str, values: &[String]| {
+        words.push(option.to_string());
+        words.extend(values.iter().map(|v| quote(v)));
+    };
+    let path = |p: &PathBuf| vec![p.to_string_lossy().into_owned()];
+    if let Some(o) = &args.output {
+        add("-o", &path(o));
+    }
+    for d in &args.define {
+        add("-D", std::slice::from_ref(d));
+    }
+    if let Some(size) = &args.size {
+        add("--size", size);
+    }
+    if let Some(d) = &args.maxdepth {
+        add("--maxdepth", std::slice::from_ref(d));
+    }
+    if args.quick {
+        add("--quick", &[]);
+    }
+    if let Some(n) = args.spp {
+        add("--spp", &[n.to_string()]);
+    }
+    if let Some(name) = &args.sampler {
+        add("--sampler", std::slice::from_ref(name));
+    }
+    if let Some(t) = args.noise_threshold {
+        add("--noise-threshold", &[t.to_string()]);
+    }
+    if let Some(seed) = args.seed {
+        add("--seed", &[seed.to_string()]);
+    }
+    if let Some(a) = args.aov {
+        let on = [a.albedo, a.normal, a.depth, a.alpha];
+        let names: Vec<&str> = AOV_NAMES
+            .iter()
+            .zip(on)
+            .filter(|(_, on)| *on)
+            .map(|(n, _)| *n)
+            .collect();
+        add("--aov", &[names.join(",")]);
+    }
+    if args.denoise {
+        add("--denoise", &[]);
+    }
+    if let Some(m) = &args.spp_map {
+        add("--spp-map", &path(m));
+    }
+    if let Some(s) = &args.state {
+        add("--state", &path(s));
+    }
+    if let Some(c) = args.checkpoint {
+        add("--checkpoint", &[c.to_string()]);
+    }
+    add("--resume", &[state.to_string()]);
+    words.join(" ")
 }
 
 /// Worker threads for `--threads N` (all cores without it), or the exit code after

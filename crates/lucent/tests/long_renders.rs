@@ -165,7 +165,7 @@ fn a_resumed_render_is_the_render_made_in_one_go() {
     fails(
         &dir,
         &["render", "t.test", "-o", "x.exr", "--resume", "a.lstate", "--spp", "16"],
-        "the scene's text has changed",
+        "the scene's text (or its -D, --size or --maxdepth overrides) has changed",
     );
     fails(
         &dir,
@@ -287,6 +287,7 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
     let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
         .args(["render", "s.test", "-o", "out.exr", "-q", "--checkpoint", "0.5"])
         .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
     // A checkpoint appears while the render runs.
@@ -306,6 +307,12 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
         stopped.elapsed()
     );
     assert_eq!(out.status.code(), Some(130));
+    // The command it prints continues this very render (the options as given).
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("continue with: lucent render s.test -o out.exr --checkpoint 0.5 --resume out.partial.lstate"),
+        "{said}"
+    );
     assert_eq!(
         fs::read(dir.join("out.exr")).unwrap(),
         b"an earlier render",
