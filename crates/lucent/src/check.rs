@@ -23,7 +23,7 @@ pub struct CheckArgs {
     #[arg(long)]
     pub strict: bool,
     /// The memory the scene may take (e.g. 4G, 512M); default: 3/4 of the machine's.
-    #[arg(long, value_name = "SIZE", value_parser = crate::render::parse_size)]
+    #[arg(long, value_name = "SIZE", value_parser = crate::render_args::parse_size)]
     pub memory_limit: Option<u64>,
 }
 

@@ -17,6 +17,7 @@ mod plan;
 mod plan_command;
 mod progress;
 mod render;
+mod render_args;
 mod settings_args;
 mod signals;
 mod targets;
@@ -45,7 +46,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an image.
-    Render(Box<render::RenderArgs>),
+    Render(Box<render_args::RenderArgs>),
     /// Parse and validate a scene without rendering it, and print what it holds.
     Check(check::CheckArgs),
     /// Compare two images (PNG or JPEG) pixel by pixel.

@@ -16,7 +16,7 @@ use lucent_io::state::{merge, read_state};
 use crate::aov_args::{parse_aovs, AovSelection};
 use crate::output::{choose_output, write_all, Encoded};
 use crate::picture::{aov_file, encode_picture, image_bytes, Extras};
-use crate::render::parse_size;
+use crate::render_args::parse_size;
 use crate::targets::check_targets;
 use crate::EXIT_BAD_INPUT;
 

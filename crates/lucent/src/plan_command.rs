@@ -6,7 +6,8 @@ use std::path::PathBuf;
 use clap::Args;
 
 use crate::plan::PlanRequest;
-use crate::render::{run_one, RenderArgs};
+use crate::render::run_one;
+use crate::render_args::RenderArgs;
 use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]

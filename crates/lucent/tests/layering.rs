@@ -70,6 +70,7 @@ const CLI: Floors = &[
     ("picture", 1),
     ("partial", 2),
     ("plan", 2),
+    ("render_args", 2),
     ("passes", 1),
     ("render", 3),
     ("check", 3),
