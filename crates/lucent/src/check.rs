@@ -17,7 +17,7 @@ use crate::EXIT_BAD_INPUT;
 
 #[derive(Args)]
 pub struct CheckArgs {
-    /// The scene file.
+    /// The scene file (`-`: standard input).
     pub scene: PathBuf,
     /// Treat unknown commands as errors.
     #[arg(long)]
@@ -36,7 +36,20 @@ pub fn run(args: &CheckArgs) -> u8 {
             .memory_limit
             .unwrap_or_else(lucent_io::resources::Budget::machine_default),
     };
-    let mut session = Session::open(&args.scene, options);
+    // `-`: the scene from standard input, as `render -` reads it.
+    let mut session = if args.scene.as_os_str() == "-" {
+        let mut text = Vec::new();
+        let read = std::io::Read::read_to_end(&mut std::io::Read::take(std::io::stdin(), 1 << 30), &mut text);
+        if let Err(e) = read {
+            eprintln!("lucent: error: cannot read the scene from standard input: {e}");
+            return EXIT_BAD_INPUT;
+        }
+        let mut s = Session::parse_text("-", &text, options);
+        s.build();
+        s
+    } else {
+        Session::open(&args.scene, options)
+    };
     if let Some(built) = &session.built {
         warn_if_absurd(&session.desc, &built.work, &mut session.diags);
     }

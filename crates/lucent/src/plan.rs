@@ -190,9 +190,15 @@ pub fn task_from_json(
         };
         inner.split(',').map(|v| v.trim().parse::<u64>().ok()).collect()
     };
-    let header = |key: &str| text.lines().find_map(|l| numbers(l, key));
-    let resolution = header("resolution").ok_or("it has no \"resolution\": not a plan lucent wrote")?;
-    let spp = header("spp").ok_or("it has no \"spp\": not a plan lucent wrote")?;
+    // (The keys are looked for in the text, not line by line: a plan reformatted by
+    // another tool, or onto one line, reads the same.)
+    let resolution = numbers(text, "resolution").ok_or("it has no \"resolution\": not a plan lucent wrote")?;
+    let spp = numbers(text, "spp").ok_or("it has no \"spp\": not a plan lucent wrote")?;
+    if resolution.len() != 2 || spp.len() != 1 {
+        return Err(
+            "its \"resolution\" is not [width, height] or its \"spp\" not one number: not a plan lucent wrote".into(),
+        );
+    }
     if resolution != [job.resolution.width as u64, job.resolution.height as u64] || spp != [job.spp as u64] {
         return Err(format!(
             "it is a plan of a {} x {} render at {} samples per pixel, and this render is {} x {} at {}",
@@ -204,12 +210,12 @@ pub fn task_from_json(
             job.spp
         ));
     }
-    let listed: Vec<&str> = text.lines().filter(|l| l.contains("\"index\"")).collect();
+    let listed: Vec<&str> = text.split("\"index\"").skip(1).collect();
     if listed.len() != tasks as usize {
         return Err(format!("it has {} tasks, not {tasks}", listed.len()));
     }
-    let line = listed[i as usize];
-    let (p, s) = match (numbers(line, "pixels"), numbers(line, "samples")) {
+    let task = listed[i as usize];
+    let (p, s) = match (numbers(task, "pixels"), numbers(task, "samples")) {
         (Some(p), Some(s)) if p.len() == 4 && s.len() == 2 && p.iter().chain(&s).all(|&v| v <= u32::MAX as u64) => {
             (p, s)
         }
@@ -352,6 +358,13 @@ mod tests {
             .unwrap_err()
             .contains("16 samples per pixel"));
         assert!(task_from_json("{}", &job, 0, 2).is_err());
+        // Reformatted onto one line (as `jq -c` writes it): the same tasks.
+        let one_line: String = text.lines().map(str::trim).collect();
+        assert_eq!(task_from_json(&one_line, &job, 1, 2), Ok((plan.tasks[1].pixels, 0..16)));
+        let three = text.replace("[40, 30]", "[40, 30, 1]");
+        assert!(task_from_json(&three, &job, 0, 2)
+            .unwrap_err()
+            .contains("not [width, height]"));
     }
 
     #[test]

@@ -108,7 +108,7 @@ fn missing_scene_and_unwritable_output() {
     let o = lucent(&dir, &["render", "a.test", "-o", "no/such/dir/out.png"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(
-        stderr(&o).contains("error: cannot write no/such/dir/out.png: no such file"),
+        stderr(&o).contains("error: cannot write no/such/dir/out.png: no such folder: no/such/dir"),
         "{}",
         stderr(&o)
     );
@@ -580,4 +580,16 @@ fn several_scenes_in_one_run_and_a_scene_on_standard_input() {
     assert!(o.status.success(), "{}", stderr(&o));
     let pixels = |name: &str| image::open(dir.join(name)).unwrap().to_rgb8().into_raw();
     assert_eq!(pixels("stdin.png"), pixels("a.png"));
+    // `check -` reads it too.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["check", "-"])
+        .current_dir(&dir)
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(SCENE.as_bytes()).unwrap();
+    let o = child.wait_with_output().unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("scene:      -"));
 }

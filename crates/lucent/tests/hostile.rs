@@ -548,7 +548,7 @@ fn state_files_and_plans_are_read_as_inputs_and_never_overwritten() {
         ),
         (
             vec!["merge", "a.lstate", "-o", "m.png", "--memory-limit", "1K"],
-            "a.lstate: the state file and its film needs about 100 kB, more than the 1 kB left",
+            "a.lstate: the state file and its film needs about 100 kB, more than the 1.0 kB left",
         ),
         (
             vec![

@@ -159,14 +159,17 @@ pub fn kind(meta: &std::fs::Metadata) -> &'static str {
 /// A byte count for people: "512 kB", "3.2 GB".
 pub fn bytes(n: u64) -> String {
     let n = n as f64;
-    if n < 1e3 {
-        format!("{n} bytes")
-    } else if n < 1e6 {
-        format!("{:.0} kB", n / 1e3)
-    } else if n < 1e9 {
-        format!("{:.0} MB", n / 1e6)
+    let (v, unit) = match n {
+        _ if n < 1e3 => return format!("{n} bytes"),
+        _ if n < 1e6 => (n / 1e3, "kB"),
+        _ if n < 1e9 => (n / 1e6, "MB"),
+        _ => (n / 1e9, "GB"),
+    };
+    // Two figures at least: "1.2 kB, more than the 1.0 kB left", not "1 kB … 1 kB".
+    if v < 10.0 || unit == "GB" {
+        format!("{v:.1} {unit}")
     } else {
-        format!("{:.1} GB", n / 1e9)
+        format!("{v:.0} {unit}")
     }
 }
 

@@ -143,6 +143,17 @@ pub fn write_together(outputs: &[(&OutputTarget, &[u8])]) -> Result<(), (usize, 
 
 /// A regular file to be (re)written: its folder must take a new file.
 fn new_file(path: PathBuf) -> Result<OutputTarget, String> {
+    // A missing folder is named as such (the temporary file's error would say "no such
+    // file" of the file being made).
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    match fs::metadata(dir) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(format!("no such folder: {}", dir.display())),
+        Ok(m) if !m.is_dir() => return Err(format!("{} is not a folder", dir.display())),
+        _ => {}
+    }
     let tmp = TemporaryFile::create(&path)?;
     drop(tmp);
     Ok(OutputTarget::File(path))
