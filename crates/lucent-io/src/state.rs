@@ -35,6 +35,7 @@ use std::path::Path;
 
 use lucent_core::film::{AovSum, ExactSum, Film, PixelNoise};
 use lucent_core::render::job::PixelRect;
+use lucent_core::sampler::SamplerKind;
 
 use crate::cse167::MAX_PIXELS;
 use crate::fnv::{fnv1a, START as FNV_START};
@@ -92,7 +93,8 @@ impl RenderState {
         let mut out = format!(
             "{MAGIC}\nscene {:016x}\nname {}\nresolution {} {}\npixels {} {} {} {}\nspp {}\nsamples {} {}\nseed {}\nsampler {}\npixelsampling {}\ngamma {:08x}\naovs {}\nnoisethreshold {}\ndata\n",
             h.scene_hash,
-            h.scene_name.replace('\n', " "),
+            // (One line, and no CR at its end for a reader to take for a CR LF.)
+            h.scene_name.replace(['\n', '\r'], " "),
             h.resolution.0,
             h.resolution.1,
             p.x0,
@@ -224,7 +226,15 @@ impl RenderState {
         let samples = small(&s[0], "first sample")?..small(&s[1], "sample end")?;
         let seed = num(&field("seed", 1)?[0], "seed")?;
         let sampler = field("sampler", 1)?.remove(0);
+        if !SamplerKind::ALL.iter().any(|(name, _)| *name == sampler) {
+            return Err(format!("the header's sampler '{sampler}' is not one lucent has"));
+        }
         let pixel_sampling = field("pixelsampling", 1)?.remove(0);
+        if !["uniform", "stratified"].contains(&pixel_sampling.as_str()) {
+            return Err(format!(
+                "the header's pixelsampling '{pixel_sampling}' is not uniform or stratified"
+            ));
+        }
         let g = field("gamma", 1)?;
         let gamma =
             f32::from_bits(u32::from_str_radix(&g[0], 16).map_err(|_| "the header's gamma is not hexadecimal")?);
@@ -668,6 +678,12 @@ mod tests {
         assert!(RenderState::decode(&s.encode())
             .unwrap_err()
             .contains("not what a state file holds"));
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.header.sampler = "s%bol".into();
+        assert!(RenderState::decode(&s.encode()).unwrap_err().contains("sampler"));
+        let mut s = state(rect(0, 2, 0, 2), 4..8);
+        s.header.pixel_sampling = "unifrom".into();
+        assert!(RenderState::decode(&s.encode()).unwrap_err().contains("pixelsampling"));
         // At the clamp in every sample: still a state.
         let mut s = state(rect(0, 2, 0, 2), 4..8);
         s.film.sums_mut()[0] = ExactSum([4 * (1i128 << 104), -4 * (1i128 << 104), 0]);
