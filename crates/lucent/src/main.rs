@@ -61,6 +61,14 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A file-size limit (`ulimit -f`, common on batch nodes) makes a write that passes it
+    // fail with "file too large", which every output reports and cleans up after,
+    // instead of a SIGXFSZ that would end the run with its temporary files left behind.
+    // SAFETY: setting a signal's disposition before any thread is started.
+    #[cfg(unix)]
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
     let cli = Cli::parse();
     let code = match cli.command {
         Command::Render(a) => render::run(&a),

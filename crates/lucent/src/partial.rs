@@ -1,6 +1,7 @@
 //! Where a render's partial results go — checkpoints, and what an interrupt leaves —
-//! beside the output, never over it: `OUT.partial.EXT` and, without `--state`,
-//! `OUT.partial.lstate`.
+//! beside the outputs, never over them: `OUT.partial.EXT`, and the state beside
+//! `--state` (`STATE.partial.lstate`: a task killed by Slurm leaves no `STATE` that a
+//! resubmission would take for done) or, without it, `OUT.partial.lstate`.
 
 use std::path::PathBuf;
 
@@ -12,10 +13,10 @@ use crate::output::{write_all, Encoded, Output};
 use crate::picture::Extras;
 
 /// Where a partial render goes: `OUT.partial.EXT` beside the output (nothing for standard
-/// output or a device) and the state at `--state`, else `OUT.partial.lstate`.
+/// output or a device) and the state beside `--state`, else `OUT.partial.lstate`.
 pub struct Partial {
     image: Option<Output>,
-    state: (PathBuf, bool),
+    state: PathBuf,
 }
 
 impl Partial {
@@ -41,17 +42,20 @@ impl Partial {
             .then(|| crate::output::choose_output(Some(&with(&ext)), desc, &mut quiet).ok())
             .flatten();
         let state = match state {
-            Some(p) => (p.clone(), false),
-            None => (with("lstate"), true),
+            Some(p) => {
+                let stem = p
+                    .file_stem()
+                    .map_or("state".into(), |s| s.to_string_lossy().into_owned());
+                p.with_file_name(format!("{stem}.partial.lstate"))
+            }
+            None => with("lstate"),
         };
         Partial { image, state }
     }
 
     /// Where the partial results would go (the names that can be written).
     pub fn targets(&self) -> Vec<(PathBuf, OutputTarget)> {
-        let state = OutputTarget::resolve(&self.state.0)
-            .ok()
-            .map(|t| (self.state.0.clone(), t));
+        let state = OutputTarget::resolve(&self.state).ok().map(|t| (self.state.clone(), t));
         let image = self.image.as_ref().map(|o| (o.name.clone(), o.target.clone()));
         image.into_iter().chain(state).collect()
     }
@@ -63,7 +67,7 @@ impl Partial {
     }
 
     pub fn state_name(&self) -> String {
-        self.state.0.display().to_string()
+        self.state.display().to_string()
     }
 
     /// Writes the partial image (with the passes and denoising of `extras`) and the
@@ -73,22 +77,22 @@ impl Partial {
             Some(img) => crate::picture::encode_picture(img, film, &header, extras)?,
             None => Vec::new(),
         };
-        let target = OutputTarget::resolve(&self.state.0)
-            .map_err(|e| format!("cannot write {}: {e}", self.state.0.display()))?;
+        let target =
+            OutputTarget::resolve(&self.state).map_err(|e| format!("cannot write {}: {e}", self.state.display()))?;
         let state = RenderState {
             header,
             film: film.clone(),
         };
         files.push(Encoded {
-            name: self.state.0.clone(),
+            name: self.state.clone(),
             target,
             bytes: state.encode(),
         });
         write_all(&files)
     }
 
-    /// Removes what checkpoints wrote, once the render is complete (the state at
-    /// `--state` is the final one by then, and stays).
+    /// Removes what checkpoints wrote, once the render is complete (the final state at
+    /// `--state` stays).
     pub fn remove(&self, extras: &Extras) {
         if let Some(img) = &self.image {
             let _ = std::fs::remove_file(&img.name);
@@ -96,8 +100,6 @@ impl Partial {
                 let _ = std::fs::remove_file(&side.name);
             }
         }
-        if self.state.1 {
-            let _ = std::fs::remove_file(&self.state.0);
-        }
+        let _ = std::fs::remove_file(&self.state);
     }
 }

@@ -19,7 +19,7 @@ use lucent_core::sampler::SamplerKind;
 use lucent_io::build::warn_if_absurd;
 use lucent_io::diag::Diagnostics;
 use lucent_io::resources::input::FileId;
-use lucent_io::resources::{Budget, OutputTarget};
+use lucent_io::resources::{Budget, Inputs, OutputTarget};
 use lucent_io::session::{Renderer, Session, SessionOptions};
 use lucent_io::state::{RenderState, StateHeader};
 
@@ -181,9 +181,9 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         },
         None => None,
     };
-    // Partial results (a checkpoint, or what an interrupt leaves) go beside the output,
-    // never over it: OUT.partial.png and, without --state, OUT.partial.lstate. They may
-    // replace the state resumed from (they hold its samples), no other input.
+    // Partial results (a checkpoint, or what an interrupt leaves) go beside the outputs,
+    // never over them: OUT.partial.png, and STATE.partial.lstate or OUT.partial.lstate.
+    // They may replace the state resumed from (they hold its samples), no other input.
     let partial = Partial::beside(&out, &args.state, &session.desc);
     let partial_targets = partial.targets();
     let mut final_targets: Vec<(&Path, &OutputTarget)> = vec![(&out.name, &out.target)];
@@ -199,6 +199,9 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         }
     }
     checked = checked.and_then(|()| check_targets(&final_targets, &named));
+    // No partial result may be one of the final outputs either (`--spp-map x.partial.png`).
+    let every: Vec<(&Path, &OutputTarget)> = final_targets.iter().chain(&partials).copied().collect();
+    checked = checked.and_then(|()| check_targets(&every, &Inputs::default()));
     if let Err(e) = checked {
         report(&session.diags, &session.desc.sources, false);
         eprintln!("lucent: error: {e}");
@@ -556,6 +559,6 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
 pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
     Renderer::new(threads.map(|n| n as usize)).map_err(|e| {
         eprintln!("lucent: error: {e}");
-        1
+        EXIT_BAD_INPUT
     })
 }

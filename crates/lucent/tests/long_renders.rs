@@ -342,6 +342,50 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
     assert!(fs::read(dir.join("resumed.exr")).unwrap() == fs::read(dir.join("one.exr")).unwrap());
 }
 
+/// A task killed by Slurm (SIGTERM) leaves its partial state beside `--state`, never at
+/// it: a resubmission takes an existing state for a finished task.
+#[test]
+fn a_killed_task_leaves_no_state_but_a_partial_one_beside_it() {
+    use std::time::{Duration, Instant};
+    let dir = workdir("killed-task");
+    fs::write(
+        dir.join("s.test"),
+        scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000"),
+    )
+    .unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args([
+            "render",
+            "s.test",
+            "-o",
+            "/dev/null",
+            "-q",
+            "--state",
+            "t.lstate",
+            "--checkpoint",
+            "0.5",
+        ])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !dir.join("t.partial.lstate").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(143));
+    assert!(!dir.join("t.lstate").exists(), "a killed task wrote its final state");
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("--state t.lstate --checkpoint 0.5 --resume t.partial.lstate"),
+        "{said}"
+    );
+}
+
 #[test]
 fn checkpoints_are_removed_when_the_render_completes() {
     let dir = workdir("checkpoint");
