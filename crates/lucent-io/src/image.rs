@@ -8,6 +8,7 @@ use image::ImageEncoder;
 
 use crate::cse167::MAX_PIXELS;
 use crate::resources::{input::MAX_IMAGE_BYTES, read_input, Inputs};
+use crate::texture_file::decode_within;
 
 /// Encodes 8-bit RGB (interleaved, top row first) as PNG.
 pub fn encode_png(width: u32, height: u32, rgb: &[u8], info: &ImageInfo) -> Result<Vec<u8>, String> {
@@ -162,11 +163,8 @@ fn decode_bounded(path: &Path) -> Result<image::DynamicImage, String> {
             "the image is {w} x {h}, more than lucent compares (at most {MAX_PIXELS} pixels, as it renders)"
         ));
     }
-    let mut limits = image::Limits::default();
-    limits.max_alloc = Some(decoder.total_bytes() + (1 << 20));
-    let mut decoder = decoder;
-    decoder.set_limits(limits).map_err(|e| e.to_string())?;
-    image::DynamicImage::from_decoder(decoder).map_err(|e| e.to_string())
+    let bytes = decoder.total_bytes();
+    decode_within(decoder, bytes)
 }
 
 /// Reads a PNG or JPEG file (a regular file) as 8-bit RGB; the error says why not.

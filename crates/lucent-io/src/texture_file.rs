@@ -71,7 +71,7 @@ fn decode(path: &Path, res: &mut Resources) -> Result<Image, String> {
 }
 
 /// The decoder's image, the decoder held to `bytes` (and a little) of memory.
-fn decode_within(mut decoder: impl ImageDecoder, bytes: u64) -> Result<DynamicImage, String> {
+pub(crate) fn decode_within(mut decoder: impl ImageDecoder, bytes: u64) -> Result<DynamicImage, String> {
     let mut limits = image::Limits::default();
     limits.max_alloc = Some(bytes + (1 << 20));
     decoder

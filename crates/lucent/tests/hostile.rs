@@ -108,6 +108,16 @@ fn says(r: &Run, text: &str) {
     assert!(r.stderr.contains(text), "expected «{text}» in:\n{shown}");
 }
 
+/// Runs each command in `dir`: each must exit with code 2 and say its message.
+#[track_caller]
+fn refused(dir: &Path, cases: &[(Vec<&str>, &str)]) {
+    for (args, message) in cases {
+        let r = run(dir, args, seconds(30));
+        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
+        says(&r, message);
+    }
+}
+
 fn mkfifo(path: &Path) {
     let c = std::ffi::CString::new(path.to_str().unwrap()).unwrap();
     // SAFETY: a valid NUL-terminated path.
@@ -529,85 +539,84 @@ fn state_files_and_plans_are_read_as_inputs_and_never_overwritten() {
         "render", "s.test", "-o", "a.png", "--spp", "2", "--state", "a.lstate", "-q",
     ]);
     let a = fs::read(dir.join("a.lstate")).unwrap();
-    for (args, message) in [
-        (
-            vec!["merge", "fifo.lstate", "-o", "m.png"],
-            "not a regular file (a FIFO)",
-        ),
-        (
-            vec!["merge", "/dev/zero", "-o", "m.png"],
-            "not a regular file (a character device)",
-        ),
-        (
-            vec!["render", "s.test", "-o", "r.png", "--resume", "fifo.lstate"],
-            "not a regular file (a FIFO)",
-        ),
-        (
-            vec!["render", "s.test", "-o", "r.png", "--resume", "/dev/zero"],
-            "not a regular file (a character device)",
-        ),
-        (
-            vec!["merge", "a.lstate", "-o", "m.png", "--memory-limit", "1K"],
-            "a.lstate: the state file and its film needs about 100 kB, more than the 1.0 kB left",
-        ),
-        (
-            vec![
-                "render",
-                "s.test",
-                "-o",
-                "r.png",
-                "--resume",
-                "a.lstate",
-                "--memory-limit",
-                "5K",
-            ],
-            "the state file and its film needs",
-        ),
-        (
-            vec!["merge", "a.lstate", "-o", "m.png", "--state", "a.lstate"],
-            "cannot write a.lstate: it is one of this run's inputs",
-        ),
-        (
-            vec!["plan", "s.test", "--tasks", "2", "--json", "s.test"],
-            "cannot write s.test: it is one of this run's inputs",
-        ),
-        (
-            vec![
-                "render",
-                "s.test",
-                "--task",
-                "0/2",
-                "--plan",
-                "fifo.lstate",
-                "--state",
-                "t.lstate",
-            ],
-            "--plan fifo.lstate: not a regular file (a FIFO)",
-        ),
-        (
-            vec![
-                "render",
-                "s.test",
-                "--task",
-                "0/2",
-                "--plan",
-                "/dev/zero",
-                "--state",
-                "t.lstate",
-            ],
-            "--plan /dev/zero: not a regular file (a character device)",
-        ),
-        (
-            vec![
-                "render", "s.test", "--task", "0/2", "--plan", "a.lstate", "--state", "a.lstate",
-            ],
-            "cannot write a.lstate: it is one of this run's inputs",
-        ),
-    ] {
-        let r = run(&dir, &args, seconds(20));
-        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
-        says(&r, message);
-    }
+    refused(
+        &dir,
+        &[
+            (
+                vec!["merge", "fifo.lstate", "-o", "m.png"],
+                "not a regular file (a FIFO)",
+            ),
+            (
+                vec!["merge", "/dev/zero", "-o", "m.png"],
+                "not a regular file (a character device)",
+            ),
+            (
+                vec!["render", "s.test", "-o", "r.png", "--resume", "fifo.lstate"],
+                "not a regular file (a FIFO)",
+            ),
+            (
+                vec!["render", "s.test", "-o", "r.png", "--resume", "/dev/zero"],
+                "not a regular file (a character device)",
+            ),
+            (
+                vec!["merge", "a.lstate", "-o", "m.png", "--memory-limit", "1K"],
+                "a.lstate: the state file and its film needs about 100 kB, more than the 1.0 kB left",
+            ),
+            (
+                vec![
+                    "render",
+                    "s.test",
+                    "-o",
+                    "r.png",
+                    "--resume",
+                    "a.lstate",
+                    "--memory-limit",
+                    "5K",
+                ],
+                "the state file and its film needs",
+            ),
+            (
+                vec!["merge", "a.lstate", "-o", "m.png", "--state", "a.lstate"],
+                "cannot write a.lstate: it is one of this run's inputs",
+            ),
+            (
+                vec!["plan", "s.test", "--tasks", "2", "--json", "s.test"],
+                "cannot write s.test: it is one of this run's inputs",
+            ),
+            (
+                vec![
+                    "render",
+                    "s.test",
+                    "--task",
+                    "0/2",
+                    "--plan",
+                    "fifo.lstate",
+                    "--state",
+                    "t.lstate",
+                ],
+                "--plan fifo.lstate: not a regular file (a FIFO)",
+            ),
+            (
+                vec![
+                    "render",
+                    "s.test",
+                    "--task",
+                    "0/2",
+                    "--plan",
+                    "/dev/zero",
+                    "--state",
+                    "t.lstate",
+                ],
+                "--plan /dev/zero: not a regular file (a character device)",
+            ),
+            (
+                vec![
+                    "render", "s.test", "--task", "0/2", "--plan", "a.lstate", "--state", "a.lstate",
+                ],
+                "cannot write a.lstate: it is one of this run's inputs",
+            ),
+        ],
+    );
     assert_eq!(fs::read(dir.join("a.lstate")).unwrap(), a, "an input is never replaced");
     assert!(fs::read_to_string(dir.join("s.test"))
         .unwrap()
@@ -672,49 +681,48 @@ fn outputs_are_checked_together_and_written_all_or_none() {
         .into_iter()
         .map(|n| (n.clone(), fs::read(dir.join(&n)).unwrap()))
         .collect();
-    for (args, message) in [
-        // a.test's output, a.png, is the next scene.
-        (
-            vec!["render", "a.test", "a.png"],
-            "cannot write a.png: it is one of this run's inputs",
-        ),
-        (
-            vec!["render", "o.partial.lstate", "-o", "o.png"],
-            "cannot write o.partial.lstate: it is one of",
-        ),
-        (
-            vec!["render", "d.test", "-o", "o.png", "--state", "m.mtl"],
-            "cannot write m.mtl: it is one of",
-        ),
-        (
-            vec!["render", "d.test", "-o", "o.png", "--spp-map", "kd.png"],
-            "cannot write kd.png: it is one of",
-        ),
-        (
-            vec!["bench", "rays", "m.obj", "r.bin", "--hits", "r.bin"],
-            "cannot write r.bin: it is one of",
-        ),
-        (
-            vec!["render", "s.test", "-o", "y.png", "--state", "y.png"],
-            "cannot write both y.png and y.png",
-        ),
-        (
-            vec!["render", "s.test", "-o", "-", "--spp-map", "-"],
-            "cannot write both - and -",
-        ),
-        (
-            vec!["render", "s.test", "-o", "old.png", "--state", "/dev/full"],
-            "cannot write /dev/full",
-        ),
-        (
-            vec!["render", "s.test", "-o", "o.png", "--checkpoint", "1e300"],
-            "at most 1e9",
-        ),
-    ] {
-        let r = run(&dir, &args, seconds(30));
-        assert_eq!(r.code, Some(2), "{args:?}: {}", r.stderr);
-        says(&r, message);
-    }
+    refused(
+        &dir,
+        &[
+            // a.test's output, a.png, is the next scene.
+            (
+                vec!["render", "a.test", "a.png"],
+                "cannot write a.png: it is one of this run's inputs",
+            ),
+            (
+                vec!["render", "o.partial.lstate", "-o", "o.png"],
+                "cannot write o.partial.lstate: it is one of",
+            ),
+            (
+                vec!["render", "d.test", "-o", "o.png", "--state", "m.mtl"],
+                "cannot write m.mtl: it is one of",
+            ),
+            (
+                vec!["render", "d.test", "-o", "o.png", "--spp-map", "kd.png"],
+                "cannot write kd.png: it is one of",
+            ),
+            (
+                vec!["bench", "rays", "m.obj", "r.bin", "--hits", "r.bin"],
+                "cannot write r.bin: it is one of",
+            ),
+            (
+                vec!["render", "s.test", "-o", "y.png", "--state", "y.png"],
+                "cannot write both y.png and y.png",
+            ),
+            (
+                vec!["render", "s.test", "-o", "-", "--spp-map", "-"],
+                "cannot write both - and -",
+            ),
+            (
+                vec!["render", "s.test", "-o", "old.png", "--state", "/dev/full"],
+                "cannot write /dev/full",
+            ),
+            (
+                vec!["render", "s.test", "-o", "o.png", "--checkpoint", "1e300"],
+                "at most 1e9",
+            ),
+        ],
+    );
     for (name, bytes) in before {
         assert_eq!(fs::read(dir.join(&name)).unwrap(), bytes, "{name} changed");
     }
