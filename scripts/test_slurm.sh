@@ -124,6 +124,7 @@ sphere 0.5 0.3 0.4 0.25
 SCENE
 "$lucent" render "$work/scene.test" -o "$work/one.png" -q
 "$lucent" render "$work/scene.test" -o "$work/one.exr" -q
+"$lucent" render "$work/scene.test" -o "$work/one-aov.exr" --aov albedo,depth -q
 
 wait_for() { # JOBID… : until none is pending or running
     for _ in $(seq 600); do
@@ -134,16 +135,18 @@ wait_for() { # JOBID… : until none is pending or running
 }
 same() { cmp -s "$work/one.png" "$1/scene.png" && cmp -s "$work/one.exr" "$1/scene.exr"; }
 
-# 1. Eight tasks and the merge.
+# 1. Eight tasks and the merge, with auxiliary passes (the tasks keep their sums, the
+#    merge writes them).
 export LUCENT="$lucent"
 SECONDS=0
-"$here/scripts/slurm/submit.sh" render "$work/scene.test" 8 "$work/run1"
+"$here/scripts/slurm/submit.sh" render "$work/scene.test" 8 "$work/run1" --aov albedo,depth
 . "$work/run1/submission.env"
 wait_for "$array_job" "$merge_job"
 took=$SECONDS
 [ -e "$work/run1/scene.png" ] || { say "no merged image"; cat "$work/run1/"*.log; exit 1; }
-same "$work/run1" || { say "FAILED: the merged image differs from the one-go render"; exit 1; }
-say "8 tasks + merge in ${took} s: merged PNG and EXR are byte-identical to the one-go render"
+cmp -s "$work/one.png" "$work/run1/scene.png" && cmp -s "$work/one-aov.exr" "$work/run1/scene.exr" \
+    || { say "FAILED: the merged image differs from the one-go render"; exit 1; }
+say "8 tasks + merge in ${took} s: merged PNG and EXR (with --aov albedo,depth) are byte-identical to the one-go render"
 
 # 2. One task killed on purpose: held array, task 3 cancelled, the others released.
 export SBATCH_OPTIONS="--hold"

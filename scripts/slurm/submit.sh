@@ -6,7 +6,8 @@
 #       plan.txt), submits them as a job array
 #       (--array=0-(N-1), task I runs `lucent render SCENE --task I/N`) and a merge job
 #       that runs when all of them succeed (--dependency=afterok): OUTDIR/<scene>.png,
-#       .exr and .lstate.
+#       .exr and .lstate. With --aov or --denoise the merge makes the passes (in the EXR,
+#       and <scene>.aovs.exr beside the PNG) and the denoised picture.
 #   submit.sh resubmit OUTDIR
 #       submits again only the tasks whose state is missing (failed, cancelled, killed
 #       with their node), and a new merge job after them.
@@ -28,14 +29,38 @@ sbatch_job() { sbatch --parsable "${opts[@]}" "$@" | cut -d';' -f1; }
 
 # The jobs get their settings through the environment (--export=ALL): values may hold
 # commas, which --export=NAME=VALUE lists cannot.
+# The render options split between the tasks and the merge: the passes (--aov) and
+# denoising (--denoise) are made by the merge from the states, which keep the passes' sums
+# (a task writes no picture: --denoise there becomes --aov albedo,normal, the passes the
+# denoiser reads). Sets task_args and merge_args from args.
+split_args() {
+    local a aov="" denoise="" next=""
+    task_args=""; merge_args=""
+    for a in $args; do
+        if [ -n "$next" ]; then aov="$a"; next=""; continue; fi
+        case "$a" in
+            --denoise) denoise=1 ;;
+            --aov) next=1 ;;
+            --aov=*) aov="${a#--aov=}" ;;
+            *) task_args+=" $a" ;;
+        esac
+    done
+    if [ -n "$aov" ]; then task_args+=" --aov $aov"; merge_args+=" --aov $aov"; fi
+    if [ -n "$denoise" ]; then
+        merge_args+=" --denoise"
+        [ -n "$aov" ] || task_args+=" --aov albedo,normal"
+    fi
+    task_args="${task_args# }"; merge_args="${merge_args# }"
+}
+
 submit_merge() { # [DEPENDENCY]
-    LUCENT="$lucent" LUCENT_OUT="$out" LUCENT_NAME="$name" LUCENT_TASKS="$tasks" \
+    LUCENT="$lucent" LUCENT_OUT="$out" LUCENT_NAME="$name" LUCENT_TASKS="$tasks" LUCENT_MERGE_ARGS="$merge_args" \
         sbatch_job ${1:+--dependency="$1"} --output="$out/merge-%j.log" --export=ALL "$here/merge.sbatch"
 }
 
 submit_tasks() { # ARRAY_SPEC
     LUCENT="$lucent" LUCENT_SCENE="$scene" LUCENT_TASKS="$tasks" LUCENT_OUT="$out" \
-        LUCENT_ARGS="$args --plan $out/plan.json" \
+        LUCENT_ARGS="$task_args --plan $out/plan.json" \
         sbatch_job --array="$1" --output="$out/task-%a.log" --export=ALL "$here/render-task.sbatch"
 }
 
@@ -56,10 +81,11 @@ render)
     scene="$(realpath "$2")"; tasks="$3"; out="$4"; shift 4; args="$*"
     mkdir -p "$out"; out="$(realpath "$out")"
     name="$(basename "${scene%.*}")"
+    split_args
     # The plan, for the record (and a check that the scene and options are good).
     # shellcheck disable=SC2086
     # Bands (if any) balanced by the measured time of a probe; the tasks read this plan.
-    "$lucent" plan "$scene" --tasks "$tasks" $args --measure --json "$out/plan.json" -q >"$out/plan.txt"
+    "$lucent" plan "$scene" --tasks "$tasks" $task_args --measure --json "$out/plan.json" -q >"$out/plan.txt"
     array_job="$(submit_tasks "0-$((tasks - 1))")"
     merge_job="$(submit_merge "afterok:$array_job")"
     save
@@ -70,6 +96,7 @@ resubmit)
     out="$(realpath "$2")"
     # shellcheck disable=SC1091
     . "$out/submission.env"
+    split_args
     missing=()
     for ((i = 0; i < tasks; i++)); do [ -e "$out/task-$i.lstate" ] || missing+=("$i"); done
     # The old merge waits for tasks that will never succeed: it goes.

@@ -111,6 +111,13 @@ pub fn resume(
     if h.pixel_sampling != "uniform" || h.spp < 2 || now.pixel_sampling != "uniform" {
         return Err("only renders of the Monte Carlo integrators (direct, pathtracer) with spp 2 or more can be continued: the ray tracer places its samples on a grid that depends on spp, and spp 1 is the pixel centre".into());
     }
+    if h.samples.end == u32::MAX {
+        return Err(format!(
+            "it already holds samples {}..{}, the most a pixel can have",
+            h.samples.start,
+            h.samples.end - 1
+        ));
+    }
     if job.spp <= h.samples.end {
         return Err(format!(
             "it already holds samples {}..{}; ask for more with --spp (above {})",

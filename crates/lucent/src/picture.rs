@@ -89,11 +89,18 @@ pub fn take_picture_memory(
 }
 
 /// The EXR that holds the passes of a non-EXR output: `OUT.aovs.exr` beside it; `None`
-/// when the output is an EXR itself or no pass is asked for. An error when the output
-/// is standard output or a device (there is no "beside").
+/// when the output is an EXR itself, `/dev/null`, or no pass is asked for. An error when
+/// the output is standard output or another device (there is no "beside").
 pub fn aov_file(out: &Output, aovs: AovSelection) -> Result<Option<Output>, String> {
     if !aovs.any() || out.format == Format::Exr {
         return Ok(None);
+    }
+    // `-o /dev/null` keeps no picture, and no passes either: a task whose state is what
+    // counts (the state keeps the passes' sums for the merge).
+    if let OutputTarget::Device(p) = &out.target {
+        if std::fs::canonicalize(p).is_ok_and(|c| c == Path::new("/dev/null")) {
+            return Ok(None);
+        }
     }
     if !matches!(out.target, OutputTarget::File(_)) {
         return Err("--aov writes its passes to a file: name an .exr output with -o (or a file beside which OUT.aovs.exr can go)".into());

@@ -92,10 +92,21 @@ pub fn apply(
     let measure = planning.is_some_and(|p| p.measure);
     let plan = make(renderer, built, job, n, cut, monte_carlo, measure)?;
     if let Some(request) = planning {
-        print!("{}", describe(scene, job, &plan));
-        if let Some(path) = &request.json {
-            lucent_io::resources::OutputTarget::resolve(path)
-                .and_then(|t| t.write(json(scene, job, &plan).as_bytes()))
+        use lucent_io::resources::OutputTarget;
+        let target = match &request.json {
+            Some(path) => {
+                Some(OutputTarget::resolve(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?)
+            }
+            None => None,
+        };
+        // `--json -`: standard output holds the JSON alone (a program reads it), the
+        // table goes to standard error.
+        match target {
+            Some(OutputTarget::Stdout) => eprint!("{}", describe(scene, job, &plan)),
+            _ => print!("{}", describe(scene, job, &plan)),
+        }
+        if let (Some(path), Some(t)) = (&request.json, target) {
+            t.write(json(scene, job, &plan).as_bytes())
                 .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
         }
         return Ok(Planned::Printed);
@@ -213,6 +224,19 @@ pub fn task_from_json(
     let listed: Vec<&str> = text.split("\"index\"").skip(1).collect();
     if listed.len() != tasks as usize {
         return Err(format!("it has {} tasks, not {tasks}", listed.len()));
+    }
+    for (k, chunk) in listed.iter().enumerate() {
+        let index = chunk
+            .trim_start()
+            .strip_prefix(':')
+            .and_then(|r| r.trim_start().split(|c: char| !c.is_ascii_digit()).next())
+            .and_then(|n| n.parse::<usize>().ok());
+        if index != Some(k) {
+            return Err(format!(
+                "its tasks are not numbered 0 to {} in order (the task at place {k} is not \"index\": {k})",
+                tasks - 1
+            ));
+        }
     }
     let task = listed[i as usize];
     let (p, s) = match (numbers(task, "pixels"), numbers(task, "samples")) {
@@ -358,6 +382,15 @@ mod tests {
             .unwrap_err()
             .contains("16 samples per pixel"));
         assert!(task_from_json("{}", &job, 0, 2).is_err());
+        let swapped = text.replacen("\"index\": 0", "\"index\": 1", 1);
+        assert!(task_from_json(&swapped, &job, 1, 2)
+            .unwrap_err()
+            .contains("not numbered 0 to 1"));
+        // Ranges are quoted inclusive, as the plan and --samples give them.
+        let beyond = text.replace("\"samples\": [0, 15]", "\"samples\": [0, 20]");
+        assert!(task_from_json(&beyond, &job, 1, 2)
+            .unwrap_err()
+            .contains("samples 0..20 are not within the 16 samples per pixel (0..15)"));
         // Reformatted onto one line (as `jq -c` writes it): the same tasks.
         let one_line: String = text.lines().map(str::trim).collect();
         assert_eq!(task_from_json(&one_line, &job, 1, 2), Ok((plan.tasks[1].pixels, 0..16)));

@@ -38,5 +38,11 @@ pub fn run(args: &PlanArgs) -> u8 {
         json: args.json.clone(),
         measure: args.measure,
     };
-    run_one(&args.render, &args.render.scenes[0], false, Some(&request))
+    run_one(
+        &args.render,
+        &args.render.scenes[0],
+        false,
+        &mut crate::targets::RunFiles::default(),
+        Some(&request),
+    )
 }

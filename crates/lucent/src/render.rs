@@ -33,7 +33,7 @@ use crate::progress::{Finish, Progress};
 use crate::render_args::{resume_command, RenderArgs};
 use crate::settings_args::{overrides, quick};
 use crate::signals;
-use crate::targets::check_targets;
+use crate::targets::{check_targets, RunFiles};
 use crate::EXIT_BAD_INPUT;
 
 /// Renders every scene named, one after the other; the exit code is the worst of them (a
@@ -58,8 +58,9 @@ pub fn run(args: &RenderArgs) -> u8 {
         }
     }
     let mut worst = 0;
+    let mut earlier = RunFiles::default();
     for scene in &args.scenes {
-        let code = run_one(args, scene, several, None);
+        let code = run_one(args, scene, several, &mut earlier, None);
         if code >= 128 {
             return code; // stopped by a signal
         }
@@ -69,8 +70,15 @@ pub fn run(args: &RenderArgs) -> u8 {
 }
 
 /// Renders one scene — or, with `planning`, prints (and writes) the plan of its render
-/// instead of rendering it.
-pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planning: Option<&PlanRequest>) -> u8 {
+/// instead of rendering it. `earlier`: what the run's earlier scenes read and write (this
+/// scene may replace none of it); this scene's are added once it is built.
+pub fn run_one(
+    args: &RenderArgs,
+    scene: &std::path::Path,
+    several: bool,
+    earlier: &mut RunFiles,
+    planning: Option<&PlanRequest>,
+) -> u8 {
     let accel: AccelKind = args.accel.parse().expect("clap checked the value");
     let t_start = Instant::now();
     let options = SessionOptions {
@@ -202,6 +210,7 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
     // No partial result may be one of the final outputs either (`--spp-map x.partial.png`).
     let every: Vec<(&Path, &OutputTarget)> = final_targets.iter().chain(&partials).copied().collect();
     checked = checked.and_then(|()| check_targets(&every, &Inputs::default()));
+    checked = checked.and_then(|()| earlier.check(&every));
     if let Err(e) = checked {
         report(&session.diags, &session.desc.sources, false);
         eprintln!("lucent: error: {e}");
@@ -226,6 +235,9 @@ pub fn run_one(args: &RenderArgs, scene: &std::path::Path, several: bool, planni
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
+    // From here on the scene may write: the later scenes of the run must leave its inputs
+    // and its outputs alone.
+    earlier.add(&named, &every);
     let extras = Extras {
         aovs: args.aov.unwrap_or_default(),
         denoiser: denoiser.as_ref(),

@@ -650,7 +650,7 @@ fn state_files_and_plans_are_read_as_inputs_and_never_overwritten() {
 
 /// A run's outputs are checked together and written all or none: no output may replace
 /// an input of the run (another scene of it, an MTL library or its texture found while
-/// building, a ray file), two outputs may not be the same file, the partial results may
+/// building, what an earlier scene of the run read or wrote, a ray file), two outputs may not be the same file, the partial results may
 /// not replace the scene, and where one output fails (`/dev/full`) none replaces what
 /// was there.
 #[test]
@@ -671,6 +671,10 @@ fn outputs_are_checked_together_and_written_all_or_none() {
     )
     .unwrap();
     fs::write(dir.join("d.test"), format!("{scene}mesh m.obj\n")).unwrap();
+    // Scenes whose outputs are another scene's texture, or each other's.
+    fs::write(dir.join("w.test"), format!("{scene}output kd.png\n")).unwrap();
+    fs::write(dir.join("p.test"), format!("{scene}output same.png\n")).unwrap();
+    fs::write(dir.join("q.test"), format!("{scene}output same.png\n")).unwrap();
     fs::write(dir.join("old.png"), b"precious").unwrap();
     let rays: Vec<u8> = [0f32, 0.0, 5.0, 0.0, 0.0, 0.0, -1.0, 1e30]
         .iter()
@@ -688,6 +692,15 @@ fn outputs_are_checked_together_and_written_all_or_none() {
             (
                 vec!["render", "a.test", "a.png"],
                 "cannot write a.png: it is one of this run's inputs",
+            ),
+            // w.test's output is the texture d.test read: refused once d.test is done.
+            (
+                vec!["render", "d.test", "w.test"],
+                "cannot write kd.png: it is one of this run's inputs",
+            ),
+            (
+                vec!["render", "p.test", "q.test"],
+                "cannot write same.png: an earlier scene of the run wrote it",
             ),
             (
                 vec!["render", "o.partial.lstate", "-o", "o.png"],
@@ -714,6 +727,10 @@ fn outputs_are_checked_together_and_written_all_or_none() {
                 "cannot write both - and -",
             ),
             (
+                vec!["render", "s.test", "-o", "-", "--spp-map", "/dev/fd/1"],
+                "cannot write both - and /dev/fd/1",
+            ),
+            (
                 vec!["render", "s.test", "-o", "old.png", "--state", "/dev/full"],
                 "cannot write /dev/full",
             ),
@@ -723,10 +740,27 @@ fn outputs_are_checked_together_and_written_all_or_none() {
             ),
         ],
     );
+    // Standard output sent to an input (`>> kd.png`, the texture found while building).
+    let appended = fs::OpenOptions::new().append(true).open(dir.join("kd.png")).unwrap();
+    let o = Command::new(bin())
+        .args(["render", "d.test", "-o", "-"])
+        .current_dir(&dir)
+        .stdout(appended)
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("cannot write -: it is one of this run's inputs"),
+        "{stderr}"
+    );
     for (name, bytes) in before {
         assert_eq!(fs::read(dir.join(&name)).unwrap(), bytes, "{name} changed");
     }
     assert!(!dir.join("o.png").exists() && !dir.join("y.png").exists());
+    // The earlier scenes of those runs were rendered.
+    assert!(dir.join("d.png").exists() && dir.join("same.png").exists());
     assert!(temporary_files(&dir).is_empty());
 }
 

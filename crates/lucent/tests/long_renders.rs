@@ -792,6 +792,10 @@ fn the_tasks_of_a_plan_merge_into_the_one_go_bytes() {
         );
         let json = fs::read_to_string(dir.join("plan.json")).unwrap();
         assert_eq!(json.matches("\"index\"").count(), tasks.parse::<usize>().unwrap());
+        // `--json -`: standard output is the JSON alone, the table goes to standard error.
+        let piped = lucent(&dir, &["plan", "s.test", "--tasks", tasks, "--by", by, "--json", "-"]);
+        assert_eq!(String::from_utf8_lossy(&piped.stdout), json);
+        assert!(String::from_utf8_lossy(&piped.stderr).contains(expect));
         let n: u32 = tasks.parse().unwrap();
         let mut states = Vec::new();
         for i in 0..n {

@@ -118,10 +118,17 @@ impl RenderJob {
                 p.x0, p.x1, p.y0, p.y1, r.width, r.height
             ));
         }
-        if !(self.samples.start < self.samples.end && self.samples.end <= self.spp) {
+        // (Ranges are quoted as users give them, `--samples FIRST..LAST`: inclusive.)
+        if self.samples.start >= self.samples.end {
+            return Err("the sample range is empty".into());
+        }
+        if self.samples.end > self.spp {
             return Err(format!(
-                "samples {}..{} are not a range within 0..{}",
-                self.samples.start, self.samples.end, self.spp
+                "samples {}..{} are not within the {} samples per pixel (0..{})",
+                self.samples.start,
+                self.samples.end - 1,
+                self.spp,
+                self.spp.saturating_sub(1)
             ));
         }
         Ok(())
@@ -155,7 +162,10 @@ mod tests {
         assert!(crop.check().is_err(), "empty");
         let mut samples = whole.clone();
         samples.samples = 8..17;
-        assert!(samples.check().unwrap_err().contains("within 0..16"));
+        assert_eq!(
+            samples.check().unwrap_err(),
+            "samples 8..16 are not within the 16 samples per pixel (0..15)"
+        );
         samples.samples = 3..3;
         assert!(samples.check().is_err(), "empty");
         let probe = whole.probe(2, 4);

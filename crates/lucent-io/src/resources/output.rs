@@ -31,6 +31,19 @@ pub enum OutputTarget {
     Stdout,
 }
 
+/// What standard output is open on (a file, a pipe, a terminal), if it can be asked.
+pub fn standard_output() -> Option<fs::Metadata> {
+    #[cfg(unix)]
+    {
+        use std::os::fd::AsFd;
+        // A second descriptor of it, closed again when the file is dropped.
+        let fd = std::io::stdout().as_fd().try_clone_to_owned().ok()?;
+        File::from(fd).metadata().ok()
+    }
+    #[cfg(not(unix))]
+    None
+}
+
 /// Symbolic links followed before giving up (as the kernel does).
 const MAX_LINKS: usize = 40;
 /// The longest file name most file systems take.
@@ -75,11 +88,16 @@ impl OutputTarget {
 
     /// An error if writing would overwrite one of the run's inputs (through a link into
     /// `/proc` too).
+    /// Standard output too, when it was sent to an input file (`>> texture.png`).
     pub fn check_not_input(&self, inputs: &Inputs) -> Result<(), String> {
-        let (OutputTarget::File(path) | OutputTarget::Device(path)) = self else {
-            return Ok(());
+        let meta = match self {
+            OutputTarget::File(path) | OutputTarget::Device(path) => fs::metadata(path),
+            OutputTarget::Stdout => match standard_output() {
+                Some(m) if m.is_file() => Ok(m),
+                _ => return Ok(()),
+            },
         };
-        match fs::metadata(path) {
+        match meta {
             Ok(meta) => match inputs.find(FileId::of(&meta)) {
                 Some(input) => Err(format!(
                     "it is one of this run's inputs ({}); choose another output",

@@ -266,7 +266,8 @@ impl RenderState {
                 resolution.0, resolution.1
             ));
         }
-        if !(gamma > 0.0 && gamma.is_finite()) {
+        // (As the scene's `gamma` command: no subnormal value, which no scene gives.)
+        if !(gamma > 0.0 && gamma.is_normal()) {
             return Err(format!("the header's gamma {gamma} is not a number > 0"));
         }
         if let Some(t) = noise_threshold.filter(|t| !(*t >= 0.0 && t.is_finite())) {
@@ -516,7 +517,7 @@ mod tests {
         s.film.sums_mut()[3].0[2] = i128::MAX;
         let e = RenderState::decode(&s.encode()).unwrap_err();
         assert!(e.contains("not what a state file holds"), "{e}");
-        for gamma in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        for gamma in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e-40] {
             let mut s = state(rect(0, 2, 0, 2), 4..8);
             s.header.gamma = gamma;
             let e = RenderState::decode(&s.encode()).unwrap_err();
