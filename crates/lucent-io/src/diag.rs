@@ -24,13 +24,26 @@ struct SourceFile {
     name: String,
     /// Lines as text (invalid UTF-8 replaced), without their terminators.
     lines: Vec<String>,
+    /// The command line's settings (`-D`, `--size`, `--maxdepth`), not a file.
+    command_line: bool,
 }
 
 impl SourceMap {
     /// Registers a file; returns its id for [`Loc::file`].
     pub fn add(&mut self, name: String, lines: Vec<String>) -> u32 {
-        self.files.push(SourceFile { name, lines });
+        self.files.push(SourceFile {
+            name,
+            lines,
+            command_line: false,
+        });
         (self.files.len() - 1) as u32
+    }
+
+    /// Registers the command line's settings, one per line, under `name`.
+    pub fn add_command_line(&mut self, name: String, lines: Vec<String>) -> u32 {
+        let id = self.add(name, lines);
+        self.files[id as usize].command_line = true;
+        id
     }
 
     pub fn name(&self, file: u32) -> &str {
@@ -44,11 +57,18 @@ impl SourceMap {
 
     /// A 64-bit FNV-1a hash of every line of every file, in order: what render state
     /// files record as "the scene" (the files a scene reads besides its own text, meshes
-    /// and images, are not part of it).
+    /// and images, are not part of it; nor is an `spp` given on the command line).
     pub fn digest(&self) -> u64 {
         let mut h = crate::fnv::START;
         for f in &self.files {
-            for line in &f.lines {
+            // `-D spp=N` is not part of the scene, as `--spp N` is not: a render may be
+            // continued (`--resume`) with more samples given either way. (A command line
+            // of nothing else adds nothing: the scene's hash without it.)
+            let spp = |line: &String| f.command_line && line.split_whitespace().next() == Some("spp");
+            if f.command_line && f.lines.iter().all(spp) {
+                continue;
+            }
+            for line in f.lines.iter().filter(|l| !spp(l)) {
                 h = crate::fnv::fnv1a(b"\n", crate::fnv::fnv1a(line.as_bytes(), h));
             }
             h = crate::fnv::fnv1a(&[0xff], h);
@@ -321,5 +341,24 @@ mod tests {
         }
         assert_eq!(d.count(Severity::Error), MAX_ERRORS);
         assert_eq!(d.suppressed_errors, 7);
+    }
+
+    #[test]
+    fn the_scene_hash_leaves_out_only_an_spp_given_on_the_command_line() {
+        let mut file = SourceMap::default();
+        file.add("s.test".into(), vec!["size 4 4".into()]);
+        let with = |lines: &[&str]| {
+            let mut m = file.clone();
+            m.add_command_line("command line".into(), lines.iter().map(|l| l.to_string()).collect());
+            m.digest()
+        };
+        let alone = file.digest();
+        assert_eq!(with(&["spp 64"]), alone);
+        assert_eq!(with(&["spp 64", "maxdepth 3"]), with(&["maxdepth 3"]));
+        assert_ne!(with(&["maxdepth 3"]), alone);
+        // The file's own spp is its text.
+        let mut own = SourceMap::default();
+        own.add("s.test".into(), vec!["size 4 4".into(), "spp 64".into()]);
+        assert_ne!(own.digest(), alone);
     }
 }

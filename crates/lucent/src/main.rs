@@ -54,6 +54,8 @@ enum Command {
     /// Combine render state files (regions, sample ranges) into one image.
     Merge(merge::MergeArgs),
     /// Cut a render into independent tasks (for a job array), and print how.
+    // (It plans one scene: the render options it shares take several.)
+    #[command(mut_arg("scenes", |a| a.num_args(1).action(clap::ArgAction::Set)))]
     Plan(Box<plan_command::PlanArgs>),
     /// Benchmarks (figures for docs/performance.md).
     #[command(subcommand)]

@@ -143,6 +143,14 @@ fn a_resumed_render_is_the_render_made_in_one_go() {
         ],
     );
     assert!(fs::read(dir.join("one.exr")).unwrap() == fs::read(dir.join("c.exr")).unwrap());
+    // More samples asked for as a scene setting on the command line, as with --spp.
+    ok(
+        &dir,
+        &[
+            "render", "s.test", "-o", "b2.exr", "-q", "--resume", "a.lstate", "-D", "spp=16",
+        ],
+    );
+    assert!(fs::read(dir.join("b.exr")).unwrap() == fs::read(dir.join("b2.exr")).unwrap());
     fails(
         &dir,
         &["render", "s.test", "-o", "d.exr", "--resume", "b.lstate", "--spp", "16"],

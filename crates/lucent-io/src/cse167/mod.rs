@@ -144,7 +144,10 @@ pub fn parse_bytes_with(
     }
     if !overrides.is_empty() {
         let file = p.file;
-        p.file = p.desc.sources.add("command line".into(), overrides.to_vec());
+        p.file = p
+            .desc
+            .sources
+            .add_command_line("command line".into(), overrides.to_vec());
         p.overriding = true;
         for (i, line) in overrides.iter().enumerate() {
             let name = line.split_whitespace().next().unwrap_or("");
