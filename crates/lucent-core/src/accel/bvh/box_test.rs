@@ -22,18 +22,24 @@
 use std::marker::PhantomData;
 
 use super::lanes::{FusedLanes, Lanes};
-use super::wide::{WideNode, WIDTH};
+use super::wide::WideNode;
+#[cfg(test)]
+use super::wide::MAX_WIDTH as WIDTH;
 use crate::math::{gamma, Vec3A};
 use crate::ray::PreparedRay;
 
 pub(super) const FAR_WIDENING: f32 = 1.0 + 2.0 * gamma(3);
-const ROW_BYTES: usize = std::mem::size_of::<[f32; WIDTH]>();
 
-/// Row `offset` (bytes, see [`RayBoxes::near_row`]) of a node's bounds, from lane `lane`.
+/// The bytes of one row of a node's bounds.
+const fn row_bytes<const W: usize>() -> usize {
+    std::mem::size_of::<[f32; W]>()
+}
+
+/// Row `offset` (bytes) of a node's bounds, from lane `lane`.
 #[inline(always)]
-unsafe fn row_ptr(node: &WideNode, offset: usize, lane: usize) -> *const f32 {
-    debug_assert!(offset < 6 * ROW_BYTES && lane < WIDTH);
-    (node as *const WideNode)
+unsafe fn row_ptr<const W: usize>(node: &WideNode<W>, offset: usize, lane: usize) -> *const f32 {
+    debug_assert!(offset < 6 * row_bytes::<W>() && lane < W);
+    (node as *const WideNode<W>)
         .cast::<u8>()
         .add(offset)
         .cast::<f32>()
@@ -50,8 +56,8 @@ pub struct RayBoxes {
     inv_dir: Vec3A,
     /// `inv_dir` times the far widening (left alone where that overflows).
     inv_far: Vec3A,
-    /// Byte offsets in a [`WideNode`] of the rows of `bounds` holding the planes the ray
-    /// enters and leaves by (offsets, not indices: a node visit then adds nothing).
+    /// The rows of a [`WideNode`]'s `bounds` holding the planes the ray enters and leaves
+    /// by (made byte offsets for the node width by [`PlaneLanes`]).
     near_row: [usize; 3],
     far_row: [usize; 3],
     zero: [bool; 3],
@@ -71,8 +77,8 @@ impl RayBoxes {
             origin: r.ray.origin,
             inv_dir: r.inv_dir,
             inv_far,
-            near_row: [0, 1, 2].map(|a| ROW_BYTES * if positive >> a & 1 != 0 { a } else { a + 3 }),
-            far_row: [0, 1, 2].map(|a| ROW_BYTES * if positive >> a & 1 != 0 { a + 3 } else { a }),
+            near_row: [0, 1, 2].map(|a| if positive >> a & 1 != 0 { a } else { a + 3 }),
+            far_row: [0, 1, 2].map(|a| if positive >> a & 1 != 0 { a + 3 } else { a }),
             zero: [r.zero_axes.test(0), r.zero_axes.test(1), r.zero_axes.test(2)],
             t_min: r.ray.t_min,
         }
@@ -129,8 +135,8 @@ pub trait BoxTest {
     /// The boxes in slots `first .. first + N`: their entry distances, and which of them
     /// the ray enters. `ZERO`: the ray has direction components that are zero. `node`
     /// must lie in the node array the ray was prepared for.
-    unsafe fn group<const ZERO: bool>(
-        node: &WideNode,
+    unsafe fn group<const ZERO: bool, const W: usize>(
+        node: &WideNode<W>,
         r: &Self::Ray,
         t_max: f32,
         first: usize,
@@ -139,10 +145,16 @@ pub trait BoxTest {
     /// All of the node's boxes: the entry distances are stored in `dist`, the entered
     /// boxes are the returned mask's bits.
     #[inline(always)]
-    unsafe fn test<const ZERO: bool>(node: &WideNode, r: &Self::Ray, t_max: f32, dist: &mut [f32; WIDTH]) -> u32 {
+    unsafe fn test<const ZERO: bool, const W: usize>(
+        node: &WideNode<W>,
+        r: &Self::Ray,
+        t_max: f32,
+        dist: &mut [f32; W],
+    ) -> u32 {
+        debug_assert!(W.is_multiple_of(Self::Lanes::N));
         let mut mask = 0;
-        for first in (0..WIDTH).step_by(Self::Lanes::N) {
-            let (near, enters) = Self::group::<ZERO>(node, r, t_max, first);
+        for first in (0..W).step_by(Self::Lanes::N) {
+            let (near, enters) = Self::group::<ZERO, W>(node, r, t_max, first);
             near.store(dist.as_mut_ptr().add(first));
             mask |= Self::Lanes::bits(enters) << first;
         }
@@ -152,7 +164,7 @@ pub trait BoxTest {
 
 /// The lanes of row `offset` (bytes, see [`RayBoxes`]) of a node, from slot `first`.
 #[inline(always)]
-unsafe fn row<L: Lanes>(node: &WideNode, offset: usize, first: usize) -> L {
+unsafe fn row<L: Lanes, const W: usize>(node: &WideNode<W>, offset: usize, first: usize) -> L {
     L::load(row_ptr(node, offset, first))
 }
 
@@ -180,10 +192,10 @@ pub struct PlaneLanes<L> {
 
 impl<L: Lanes> PlaneLanes<L> {
     #[inline(always)]
-    unsafe fn new(
+    unsafe fn new<const W: usize>(
         r: &RayBoxes,
         [near_mul, near_off, far_mul, far_off]: [Vec3A; 4],
-        nodes: &[WideNode],
+        nodes: &[WideNode<W>],
     ) -> PlaneLanes<L> {
         let splat = |v: Vec3A| [L::splat(v.x), L::splat(v.y), L::splat(v.z)];
         let nodes = nodes.as_ptr().cast::<u8>();
@@ -193,8 +205,8 @@ impl<L: Lanes> PlaneLanes<L> {
             far_mul: splat(far_mul),
             far_off: splat(far_off),
             t_min: L::splat(r.t_min),
-            near_row: r.near_row.map(|offset| nodes.wrapping_add(offset)),
-            far_row: r.far_row.map(|offset| nodes.wrapping_add(offset)),
+            near_row: r.near_row.map(|row| nodes.wrapping_add(row * row_bytes::<W>())),
+            far_row: r.far_row.map(|row| nodes.wrapping_add(row * row_bytes::<W>())),
             nodes,
             zero: r.zero,
         }
@@ -242,7 +254,7 @@ pub type Fused<L> = Planes<L, MulSub>;
 impl<L: Lanes> Slab<L> {
     /// The prepared ray tests nodes of `nodes` only.
     #[inline(always)]
-    pub unsafe fn prepare(r: &RayBoxes, nodes: &[WideNode]) -> PlaneLanes<L> {
+    pub unsafe fn prepare<const W: usize>(r: &RayBoxes, nodes: &[WideNode<W>]) -> PlaneLanes<L> {
         PlaneLanes::new(r, [r.inv_dir, r.origin, r.inv_far, r.origin], nodes)
     }
 }
@@ -250,7 +262,7 @@ impl<L: Lanes> Slab<L> {
 impl<L: FusedLanes> Fused<L> {
     /// `offsets` must come from the same ray; the prepared ray tests nodes of `nodes` only.
     #[inline(always)]
-    pub unsafe fn prepare(r: &RayBoxes, offsets: &FmaOffsets, nodes: &[WideNode]) -> PlaneLanes<L> {
+    pub unsafe fn prepare<const W: usize>(r: &RayBoxes, offsets: &FmaOffsets, nodes: &[WideNode<W>]) -> PlaneLanes<L> {
         PlaneLanes::new(r, [r.inv_dir, offsets.near, offsets.inv_far, offsets.far], nodes)
     }
 }
@@ -259,9 +271,14 @@ impl<L: Lanes, D: Distance<L>> BoxTest for Planes<L, D> {
     type Ray = PlaneLanes<L>;
     type Lanes = L;
     #[inline(always)]
-    unsafe fn group<const ZERO: bool>(node: &WideNode, r: &PlaneLanes<L>, t_max: f32, first: usize) -> (L, L::Mask) {
+    unsafe fn group<const ZERO: bool, const W: usize>(
+        node: &WideNode<W>,
+        r: &PlaneLanes<L>,
+        t_max: f32,
+        first: usize,
+    ) -> (L, L::Mask) {
         // The node's byte offset in the array, and the lanes' within a row.
-        let at = (node as *const WideNode as usize).wrapping_sub(r.nodes as usize) + first * 4;
+        let at = (node as *const WideNode<W> as usize).wrapping_sub(r.nodes as usize) + first * 4;
         let mut near = r.t_min;
         let mut far = L::splat(t_max);
         let mut inside = L::all();
@@ -269,8 +286,8 @@ impl<L: Lanes, D: Distance<L>> BoxTest for Planes<L, D> {
             if ZERO && r.zero[a] {
                 // The plain test's offset is the origin.
                 let o = r.near_off[a];
-                let lo = row::<L>(node, a * ROW_BYTES, first);
-                let hi = row::<L>(node, (a + 3) * ROW_BYTES, first);
+                let lo = row::<L, W>(node, a * row_bytes::<W>(), first);
+                let hi = row::<L, W>(node, (a + 3) * row_bytes::<W>(), first);
                 inside = L::and(inside, L::and(lo.le(o), o.le(hi)));
             } else {
                 let n = D::distance(
@@ -359,9 +376,9 @@ pub(super) mod tests {
             // SAFETY: callers only pass tests this CPU can run.
             let mask = unsafe {
                 if zero {
-                    T::test::<true>(node, rb, search_limit(t_max), &mut dist)
+                    T::test::<true, WIDTH>(node, rb, search_limit(t_max), &mut dist)
                 } else {
-                    T::test::<false>(node, rb, search_limit(t_max), &mut dist)
+                    T::test::<false, WIDTH>(node, rb, search_limit(t_max), &mut dist)
                 }
             };
             for (slot, &entry) in dist.iter().enumerate() {

@@ -3,7 +3,8 @@
 //! over the binary tree, after Ylitie, Karras and Laine (2017), "Efficient incoherent
 //! ray traversal on GPUs through compressed wide BVHs", section 4.
 //!
-//! A wide node standing for binary node `n` has up to sixteen children, each a binary
+//! A wide node standing for binary node `n` has up to `width` children (sixteen or eight,
+//! see [`super::wide`]), each a binary
 //! node below `n`: the roots of a cut through `n`'s subtree. Each child is a leaf (a
 //! subtree of at most [`MERGE`] primitives, tested as packets of four) or a wide node of
 //! its own. `cost(n, i)` is the least cost of `n`'s subtree when it may take up to `i`
@@ -11,7 +12,7 @@
 
 use super::binary::{BinaryTree, Kind};
 use super::packet::LANES;
-use super::wide::WIDTH;
+use super::wide::MAX_WIDTH;
 
 /// The most primitives a leaf holds (two packets).
 pub(super) const MERGE: u32 = 2 * LANES as u32;
@@ -25,6 +26,8 @@ const PACKET_COST: f32 = 1.0;
 /// The plan: for every binary node, how its subtree is cut.
 pub(super) struct Plan {
     decisions: Vec<Decision>,
+    /// The most children of a wide node.
+    width: usize,
 }
 
 /// How binary node `n`'s subtree is cut (the costs that chose it are gone by then).
@@ -32,7 +35,7 @@ pub(super) struct Plan {
 struct Decision {
     /// `split[i - 1]` for `i ≥ 2`: how many of up to `i` slots go to the left child (0:
     /// the subtree takes no more than `i - 1`). `split[0]`: 0 when the subtree is one leaf.
-    split: [u8; WIDTH],
+    split: [u8; MAX_WIDTH],
     /// How many slots the left child gets when this node becomes a wide node.
     node_split: u8,
 }
@@ -41,9 +44,9 @@ struct Decision {
 #[derive(Clone, Copy)]
 struct Summary {
     /// `cost[i - 1]`: the least cost with up to `i` slots.
-    cost: [f32; WIDTH],
+    cost: [f32; MAX_WIDTH],
     prims: u32,
-    /// The most slots the subtree can fill (its binary leaves, at most sixteen): `cost` is
+    /// The most slots the subtree can fill (its binary leaves, at most `width`): `cost` is
     /// the same from there on.
     slots: usize,
 }
@@ -53,12 +56,14 @@ struct Summary {
 const PARALLEL_NODES: usize = 1 << 14;
 
 impl Plan {
-    pub(super) fn new(tree: &BinaryTree) -> Plan {
+    /// The plan of nodes of at most `width` children (2 to [`MAX_WIDTH`]).
+    pub(super) fn new(tree: &BinaryTree, width: usize) -> Plan {
+        assert!((2..=MAX_WIDTH).contains(&width));
         let mut decisions = vec![Decision::default(); tree.nodes.len()];
         if !decisions.is_empty() {
-            plan_subtree(tree, &mut decisions, 0);
+            plan_subtree(tree, &mut decisions, 0, width);
         }
-        Plan { decisions }
+        Plan { decisions, width }
     }
 
     /// Whether binary node `n`, as a child slot, is a leaf.
@@ -68,19 +73,19 @@ impl Plan {
 
     /// The children of the wide node standing for interior binary node `b`, in the
     /// binary tree's left-to-right order, and how many.
-    pub(super) fn children(&self, tree: &BinaryTree, b: u32) -> ([u32; WIDTH], usize) {
+    pub(super) fn children(&self, tree: &BinaryTree, b: u32) -> ([u32; MAX_WIDTH], usize) {
         let Kind::Interior { left, right } = tree.nodes[b as usize].kind else {
             unreachable!("interior")
         };
-        let mut out = ([0u32; WIDTH], 0usize);
+        let mut out = ([0u32; MAX_WIDTH], 0usize);
         let k = self.decisions[b as usize].node_split as usize;
         self.cut(tree, left, k, &mut out);
-        self.cut(tree, right, WIDTH - k, &mut out);
+        self.cut(tree, right, self.width - k, &mut out);
         out
     }
 
     /// Appends the roots of node `n`'s subtree cut into up to `i` slots.
-    fn cut(&self, tree: &BinaryTree, n: u32, i: usize, out: &mut ([u32; WIDTH], usize)) {
+    fn cut(&self, tree: &BinaryTree, n: u32, i: usize, out: &mut ([u32; MAX_WIDTH], usize)) {
         let mut i = i;
         let d = &self.decisions[n as usize];
         while i > 1 && d.split[i - 1] == 0 {
@@ -102,7 +107,7 @@ impl Plan {
 
 /// Plans binary node `first`'s subtree, whose decisions are `decisions` (a subtree's
 /// nodes are contiguous: the node, its left subtree, its right subtree).
-fn plan_subtree(tree: &BinaryTree, decisions: &mut [Decision], first: usize) -> Summary {
+fn plan_subtree(tree: &BinaryTree, decisions: &mut [Decision], first: usize, width: usize) -> Summary {
     let node = &tree.nodes[first];
     let Kind::Interior { left, right } = node.kind else {
         let Kind::Leaf { count, .. } = node.kind else {
@@ -110,7 +115,7 @@ fn plan_subtree(tree: &BinaryTree, decisions: &mut [Decision], first: usize) -> 
         };
         let cost = node.bounds.surface_area() * PACKET_COST * packets(count);
         return Summary {
-            cost: [cost; WIDTH],
+            cost: [cost; MAX_WIDTH],
             prims: count,
             slots: 1,
         };
@@ -120,16 +125,16 @@ fn plan_subtree(tree: &BinaryTree, decisions: &mut [Decision], first: usize) -> 
     let (l, r) = rest.split_at_mut(right as usize - left as usize);
     let (l, r) = if parallel {
         rayon::join(
-            || plan_subtree(tree, l, left as usize),
-            || plan_subtree(tree, r, right as usize),
+            || plan_subtree(tree, l, left as usize, width),
+            || plan_subtree(tree, r, right as usize, width),
         )
     } else {
         (
-            plan_subtree(tree, l, left as usize),
-            plan_subtree(tree, r, right as usize),
+            plan_subtree(tree, l, left as usize, width),
+            plan_subtree(tree, r, right as usize, width),
         )
     };
-    let (summary, decision) = combine(node.bounds.surface_area(), &l, &r);
+    let (summary, decision) = combine(node.bounds.surface_area(), &l, &r, width);
     own[0] = decision;
     summary
 }
@@ -139,15 +144,15 @@ fn packets(prims: u32) -> f32 {
 }
 
 /// An interior node of surface area `area` over children `l` and `r`: its costs, and
-/// how it is cut.
-fn combine(area: f32, l: &Summary, r: &Summary) -> (Summary, Decision) {
+/// how it is cut into nodes of at most `width` children.
+fn combine(area: f32, l: &Summary, r: &Summary, width: usize) -> (Summary, Decision) {
     let prims = l.prims + r.prims;
-    let slots = (l.slots + r.slots).min(WIDTH);
+    let slots = (l.slots + r.slots).min(width);
     // shared[j]: the least cost of both children in up to j slots, and the left child's
     // share of them. Slots beyond a child's `slots` change nothing, so they are not
     // tried (most nodes are near the leaves, with few).
-    let mut shared = [f32::INFINITY; WIDTH + 1];
-    let mut shared_split = [0u8; WIDTH + 1];
+    let mut shared = [f32::INFINITY; MAX_WIDTH + 1];
+    let mut shared_split = [0u8; MAX_WIDTH + 1];
     for j in 2..=slots {
         for k in j.saturating_sub(r.slots).max(1)..=(j - 1).min(l.slots) {
             let c = l.cost[k - 1] + r.cost[j - k - 1];
@@ -160,21 +165,21 @@ fn combine(area: f32, l: &Summary, r: &Summary) -> (Summary, Decision) {
         }
     }
     // With room for more slots than the children can fill, the best is the fullest cut.
-    for j in slots + 1..=WIDTH {
+    for j in slots + 1..=width {
         shared[j] = shared[slots];
         shared_split[j] = shared_split[slots];
     }
-    let as_node = area * NODE_COST + shared[WIDTH];
+    let as_node = area * NODE_COST + shared[width];
     let as_leaf = if prims <= MERGE {
         area * PACKET_COST * packets(prims)
     } else {
         f32::INFINITY
     };
-    let mut cost = [0.0; WIDTH];
-    let mut split = [0u8; WIDTH];
+    let mut cost = [0.0; MAX_WIDTH];
+    let mut split = [0u8; MAX_WIDTH];
     cost[0] = as_node.min(as_leaf);
     split[0] = (prims > MERGE || as_leaf > as_node) as u8;
-    for i in 2..=WIDTH {
+    for i in 2..=width {
         if shared[i] < cost[i - 2] {
             cost[i - 1] = shared[i];
             split[i - 1] = shared_split[i];
@@ -184,7 +189,7 @@ fn combine(area: f32, l: &Summary, r: &Summary) -> (Summary, Decision) {
     }
     let decision = Decision {
         split,
-        node_split: shared_split[WIDTH],
+        node_split: shared_split[width],
     };
     (Summary { cost, prims, slots }, decision)
 }
@@ -225,29 +230,29 @@ mod tests {
 
     /// The least cost of `n` as a child slot, by trying every cut below every node.
     /// (Each node's least slot cost is found once: `memo`.)
-    fn best_slot(tree: &BinaryTree, n: u32, memo: &mut HashMap<u32, f32>) -> f32 {
+    fn best_slot(tree: &BinaryTree, n: u32, width: usize, memo: &mut HashMap<u32, f32>) -> f32 {
         if let Some(&c) = memo.get(&n) {
             return c;
         }
         let c = match tree.nodes[n as usize].kind {
             Kind::Leaf { count, .. } => area(tree, n) * PACKET_COST * packets(count),
             _ if prims(tree, n) <= MERGE => {
-                (area(tree, n) * PACKET_COST * packets(prims(tree, n))).min(best_node(tree, n, memo))
+                (area(tree, n) * PACKET_COST * packets(prims(tree, n))).min(best_node(tree, n, width, memo))
             }
-            _ => best_node(tree, n, memo),
+            _ => best_node(tree, n, width, memo),
         };
         memo.insert(n, c);
         c
     }
 
-    fn best_node(tree: &BinaryTree, n: u32, memo: &mut HashMap<u32, f32>) -> f32 {
+    fn best_node(tree: &BinaryTree, n: u32, width: usize, memo: &mut HashMap<u32, f32>) -> f32 {
         let Kind::Interior { left, right } = tree.nodes[n as usize].kind else {
             unreachable!()
         };
         let mut best = f32::INFINITY;
-        for a in cuts(tree, left, WIDTH - 1) {
-            for b in cuts(tree, right, WIDTH - a.len()) {
-                let c: f32 = a.iter().chain(&b).map(|&m| best_slot(tree, m, memo)).sum();
+        for a in cuts(tree, left, width - 1) {
+            for b in cuts(tree, right, width - a.len()) {
+                let c: f32 = a.iter().chain(&b).map(|&m| best_slot(tree, m, width, memo)).sum();
                 best = best.min(c);
             }
         }
@@ -269,14 +274,23 @@ mod tests {
 
     #[test]
     fn the_plan_costs_what_the_best_of_every_cut_costs() {
-        for n in [9, 17, 24, 33, 41] {
+        for (n, width) in [
+            (9, 16),
+            (17, 16),
+            (24, 16),
+            (33, 16),
+            (41, 16),
+            (17, 8),
+            (33, 8),
+            (41, 8),
+        ] {
             let tree = binary::build(boxes(n).into_iter());
-            let plan = Plan::new(&tree);
-            let best = best_node(&tree, 0, &mut HashMap::new());
+            let plan = Plan::new(&tree, width);
+            let best = best_node(&tree, 0, width, &mut HashMap::new());
             let planned = planned_node(&plan, &tree, 0);
             assert!(
                 (planned - best).abs() <= 1e-5 * best,
-                "{n} boxes: {planned} against {best}"
+                "{n} boxes in nodes of {width}: {planned} against {best}"
             );
         }
     }
@@ -292,16 +306,18 @@ mod tests {
                 };
                 (i, b)
             });
-            check_cuts(&binary::build(scaled));
+            let tree = binary::build(scaled);
+            check_cuts(&tree, 16);
+            check_cuts(&tree, 8);
         }
     }
 
-    fn check_cuts(tree: &BinaryTree) {
-        let plan = Plan::new(tree);
+    fn check_cuts(tree: &BinaryTree, width: usize) {
+        let plan = Plan::new(tree, width);
         let mut pending = vec![0u32];
         while let Some(n) = pending.pop() {
             let (children, count) = plan.children(tree, n);
-            assert!((2..=WIDTH).contains(&count));
+            assert!((2..=width).contains(&count));
             let total: u32 = children[..count].iter().map(|&m| prims(tree, m)).sum();
             assert_eq!(total, prims(tree, n));
             for &m in &children[..count] {

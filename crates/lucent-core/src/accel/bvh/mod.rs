@@ -1,13 +1,15 @@
-//! Bounding volume hierarchy (`--accel bvh`, the default): a 16-wide BVH over packets
-//! of four triangles.
+//! Bounding volume hierarchy (`--accel bvh`, the default): a 16-wide BVH (8-wide on CPUs
+//! whose best is AVX2) over packets of four triangles.
 //!
 //! Build ([`binary`], [`wide`]): a binned-SAH binary tree, collapsed into nodes of sixteen
-//! children whose boxes are stored as structure-of-arrays; leaves become packets of four
-//! primitives with precomputed triangle corners in SIMD layout ([`packet`]).
+//! children (eight for AVX2, [`Isa::node_width`]) whose boxes are stored as
+//! structure-of-arrays; leaves become packets of four primitives with precomputed
+//! triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): sixteen box tests per visit ([`box_test`]), eight at a time
-//! with AVX2 and FMA when the CPU has them (decided once, at build time, with
-//! `is_x86_feature_detected!`), four at a time with SSE when not; nearest child first,
+//! Traversal ([`traverse`]): a box test per child per visit ([`box_test`]): sixteen with
+//! AVX-512 (in one group or two of eight), eight in one group with AVX2 and FMA (the
+//! instruction set decided once, at build time, with `is_x86_feature_detected!`), sixteen
+//! four at a time with SSE; nearest child first,
 //! an explicit fixed-size stack, no allocation per ray; the packet test is bit-identical
 //! to the scalar watertight triangle test, so the answers are exactly the brute-force
 //! list's. Which box test and lane width a single ray's query runs on this CPU: [`query`].
@@ -86,6 +88,18 @@ impl Isa {
         matches!(self, Isa::Avx512 | Isa::Avx2)
     }
 
+    /// The children of the tree's nodes: sixteen, tested in one AVX-512 group (or two
+    /// AVX2-wide groups, four SSE ones), except for AVX2, which tests a node of eight
+    /// in one group. (Measured on an AMD EPYC without AVX-512, Zen 3: nodes of eight
+    /// 1.01–1.09× faster on primary rays than nodes of sixteen tested as two groups,
+    /// 0.99–1.08× on the other sets and packets; see docs/performance.md.)
+    pub fn node_width(self) -> usize {
+        match self {
+            Isa::Avx2 => 8,
+            _ => 16,
+        }
+    }
+
     /// How many rays a packet holds.
     pub fn packet_rays(self) -> usize {
         match self {
@@ -96,10 +110,13 @@ impl Isa {
 }
 
 pub struct Bvh {
-    nodes: Vec<WideNode>,
+    /// The nodes, of sixteen children or of eight ([`Isa::node_width`]); the other
+    /// vector is empty.
+    nodes16: Vec<WideNode<16>>,
+    nodes8: Vec<WideNode<8>>,
     packets: Vec<Packet>,
     isa: Isa,
-    /// More node levels than [`traverse::SHALLOW_LEVELS`]: queries take the paths with
+    /// More node levels than [`traverse::shallow_levels`]: queries take the paths with
     /// the large stack.
     deep: bool,
 }
@@ -125,16 +142,27 @@ impl Bvh {
         }
         refs.retain(|r| super::is_bounded(&r.bounds()));
         let tree = binary::build_refs(refs);
-        let wide = wide::collapse(&tree, prims);
         assert!(Isa::available().contains(&isa), "{isa:?} requested on a CPU without it");
-        let levels = wide::levels(&wide.nodes);
+        let (nodes16, nodes8, packets, levels) = match isa.node_width() {
+            8 => {
+                let wide = wide::collapse::<8, P>(&tree, prims);
+                let levels = wide::levels(&wide.nodes);
+                (Vec::new(), wide.nodes, wide.packets, levels)
+            }
+            _ => {
+                let wide = wide::collapse::<16, P>(&tree, prims);
+                let levels = wide::levels(&wide.nodes);
+                (wide.nodes, Vec::new(), wide.packets, levels)
+            }
+        };
         // The traversal stacks are sized by levels (the build bounds its depth).
         assert!(levels <= traverse::MAX_LEVELS, "a BVH of {levels} levels");
         Bvh {
-            nodes: wide.nodes,
-            packets: wide.packets,
+            nodes16,
+            nodes8,
+            packets,
             isa,
-            deep: levels > traverse::SHALLOW_LEVELS,
+            deep: levels > traverse::shallow_levels(isa.node_width()),
         }
     }
 
@@ -176,19 +204,20 @@ impl Bvh {
             let base = k * width;
             #[cfg(target_arch = "x86_64")]
             // (Trees deeper than the packets' stack trace their rays one by one.)
-            if self.isa.has_avx2() && !self.nodes.is_empty() && !self.deep {
+            if self.isa.has_avx2() && self.node_count() > 0 && !self.deep {
                 let mut states = [Q::start(&chunk[0]); ray_packet::MAX_PACKET];
                 for (s, r) in states.iter_mut().zip(chunk) {
                     *s = Q::start(r);
                 }
-                let (nodes, packets, states) = (&self.nodes, &self.packets, &mut states[..chunk.len()]);
+                let (packets, states) = (&self.packets, &mut states[..chunk.len()]);
                 // SAFETY: `isa` was checked against the CPU when the tree was built for
-                // these primitives, and the tree is not deep.
+                // these primitives (nodes of sixteen for AVX-512, eight for AVX2), and
+                // the tree is not deep.
                 let alone = unsafe {
                     if self.isa == Isa::Avx512 {
-                        ray_packet::traverse_avx512::<Q, P>(nodes, packets, prims, chunk, states)
+                        ray_packet::traverse_avx512::<Q, P, 16>(&self.nodes16, packets, prims, chunk, states)
                     } else {
-                        ray_packet::traverse_avx2::<Q, P>(nodes, packets, prims, chunk, states)
+                        ray_packet::traverse_avx2::<Q, P, 8>(&self.nodes8, packets, prims, chunk, states)
                     }
                 };
                 for i in packet::Lanes(alone) {
@@ -211,7 +240,13 @@ impl Bvh {
     }
 
     pub fn node_count(&self) -> usize {
-        self.nodes.len()
+        self.nodes16.len() + self.nodes8.len()
+    }
+
+    /// The node levels of the tree.
+    #[cfg(test)]
+    fn levels(&self) -> usize {
+        wide::levels(&self.nodes16).max(wide::levels(&self.nodes8))
     }
 
     /// Every primitive index the leaves hold, in leaf order.
@@ -240,7 +275,9 @@ impl<P: PrimitiveSet + ?Sized> Accelerator<P> for Bvh {
     }
 
     fn memory_bytes(&self) -> usize {
-        self.nodes.len() * std::mem::size_of::<WideNode>() + self.packets.len() * std::mem::size_of::<Packet>()
+        std::mem::size_of_val(&self.nodes16[..])
+            + std::mem::size_of_val(&self.nodes8[..])
+            + std::mem::size_of_val(&self.packets[..])
     }
 
     fn closest_hits(&self, prims: &P, rays: &[Ray], out: &mut [Option<Hit>]) {
@@ -278,7 +315,8 @@ mod tests {
     /// The nodes and packets as bytes, to compare whole structures.
     fn bytes(b: &Bvh) -> Vec<u8> {
         let raw = |p: *const u8, n: usize| unsafe { std::slice::from_raw_parts(p, n) }.to_vec();
-        let mut v = raw(b.nodes.as_ptr().cast(), std::mem::size_of_val(&b.nodes[..]));
+        let mut v = raw(b.nodes16.as_ptr().cast(), std::mem::size_of_val(&b.nodes16[..]));
+        v.extend(raw(b.nodes8.as_ptr().cast(), std::mem::size_of_val(&b.nodes8[..])));
         v.extend(raw(b.packets.as_ptr().cast(), std::mem::size_of_val(&b.packets[..])));
         v
     }
@@ -358,13 +396,14 @@ mod tests {
     fn trees_know_their_levels_and_deep_trees_give_the_same_answers() {
         use crate::accel::test_sets::Rng;
         let few = Triangles::random(1, 6);
-        assert_eq!(wide::levels(&Bvh::build(&few).nodes), 1);
+        assert_eq!(Bvh::build(&few).levels(), 1);
         let prims = Triangles::random(4, 20_000);
         let shallow = Bvh::build(&prims);
-        let levels = wide::levels(&shallow.nodes);
-        // 20,000 triangles under nodes of sixteen whose leaves hold at most eight: at least
-        // 3 levels (16³ · 8 = 32,768), and SAH trees are not much deeper.
-        assert!((3..=10).contains(&levels), "{levels} levels");
+        let levels = shallow.levels();
+        // 20,000 triangles under nodes of sixteen (eight with AVX2) whose leaves hold at
+        // most eight: at least 3 levels (16³ · 8 = 32,768), and SAH trees are not much
+        // deeper.
+        assert!((3..=14).contains(&levels), "{levels} levels");
         assert!(!shallow.deep);
         // The same tree through the large-stack path every ISA has.
         for isa in Isa::available() {

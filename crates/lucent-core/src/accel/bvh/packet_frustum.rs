@@ -27,7 +27,9 @@
 
 use super::lanes::{Avx, Lanes};
 use super::ray_lanes::RayLanes;
-use super::wide::{WideNode, WIDTH};
+use super::wide::WideNode;
+#[cfg(test)]
+use super::wide::MAX_WIDTH as WIDTH;
 
 /// The relative widening of the reciprocal directions' interval (see the module docs).
 const MARGIN: f32 = 1.0 / (1u32 << 20) as f32;
@@ -80,9 +82,9 @@ impl Frustum {
     /// (bit `c` for slot `c`): a superset of the slots the rays' own box tests enter.
     /// Their near bounds go to `bound` (eight slots at a time).
     #[inline(always)]
-    pub(super) unsafe fn children(&self, node: &WideNode, limit: f32, bound: &mut [f32; WIDTH]) -> u32 {
+    pub(super) unsafe fn children<const W: usize>(&self, node: &WideNode<W>, limit: f32, bound: &mut [f32; W]) -> u32 {
         let mut mask = 0;
-        for first in (0..WIDTH).step_by(Avx::N) {
+        for first in (0..W).step_by(Avx::N) {
             let mut near = Avx::splat(f32::NEG_INFINITY);
             let mut far = Avx::splat(f32::INFINITY);
             for a in 0..3 {

@@ -117,7 +117,12 @@ impl<L: RayLanes> BoxLanes<L> {
     /// entry distances. `ROWS`: `self.rows` is known (each axis costs two fused
     /// operations instead of four and a `min`/`max`).
     #[inline(always)]
-    pub(super) unsafe fn enters<const ROWS: bool>(&self, node: &WideNode, c: usize, limit: L) -> (u32, L) {
+    pub(super) unsafe fn enters<const ROWS: bool, const W: usize>(
+        &self,
+        node: &WideNode<W>,
+        c: usize,
+        limit: L,
+    ) -> (u32, L) {
         let mut near = self.t_min;
         let mut far = limit;
         for a in 0..3 {

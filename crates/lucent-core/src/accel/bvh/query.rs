@@ -4,7 +4,9 @@
 //! traversal itself is [`traverse`]'s.
 
 use super::box_test::{self, BoxTest, FmaOffsets, RayBoxes, Slab};
+use super::packet::Packet;
 use super::traverse::{self, DEEP_STACK, SHALLOW_STACK};
+use super::wide::WideNode;
 use super::{lanes, Bvh, Isa};
 use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
@@ -26,9 +28,11 @@ pub(super) trait Query<P: PrimitiveSet + ?Sized> {
     const ORDERED: bool;
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
-    /// direction component, and the tree at most `STACK / (WIDTH - 1)` levels deep.
-    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
-        b: &Bvh,
+    /// direction component, and the tree (`nodes`, `packets`) built for `prims` and at
+    /// most `STACK / (W - 1)` levels deep.
+    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize, const W: usize>(
+        nodes: &[WideNode<W>],
+        packets: &[Packet],
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
@@ -47,14 +51,15 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
     }
     const ORDERED: bool = true;
     #[inline(always)]
-    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
-        b: &Bvh,
+    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize, const W: usize>(
+        nodes: &[WideNode<W>],
+        packets: &[Packet],
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
         out: &mut Option<Hit>,
     ) {
-        traverse::closest::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb, out)
+        traverse::closest::<T, ZERO, P, STACK, W>(nodes, packets, prims, r, rb, out)
     }
 }
 
@@ -66,28 +71,31 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
     }
     const ORDERED: bool = false;
     #[inline(always)]
-    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize>(
-        b: &Bvh,
+    unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize, const W: usize>(
+        nodes: &[WideNode<W>],
+        packets: &[Packet],
         prims: &P,
         r: &PreparedRay,
         rb: &T::Ray,
         _: &mut (),
     ) -> bool {
-        traverse::occluded::<T, ZERO, P, STACK>(&b.nodes, &b.packets, prims, r, rb)
+        traverse::occluded::<T, ZERO, P, STACK, W>(nodes, packets, prims, r, rb)
     }
 }
 
 /// The AVX2 paths, compiled with AVX2 and FMA enabled: the fused box test for rays
-/// that have its constants, the plain one for the others. Shallow trees only.
+/// that have its constants, the plain one for the others. Shallow trees of nodes of
+/// eight (one group of eight boxes a visit) only.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
+    nodes: &[WideNode<8>],
+    packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
-    run_fused::<Q, P>(b, prims, r, out)
+    run_fused::<Q, P, 8>(nodes, packets, prims, r, out)
 }
 
 /// The AVX-512 paths. Closest hits run the same code as [`run_avx2`] (the same 8-lane
@@ -103,24 +111,26 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
+    nodes: &[WideNode<16>],
+    packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
     use box_test::Fused;
     if Q::ORDERED {
-        return run_fused::<Q, P>(b, prims, r, out);
+        return run_fused::<Q, P, 16>(nodes, packets, prims, r, out);
     }
     match FmaOffsets::new(r) {
-        Some(offsets) => Q::run::<Fused<lanes::Avx512>, false, SHALLOW_STACK>(
-            b,
+        Some(offsets) => Q::run::<Fused<lanes::Avx512>, false, SHALLOW_STACK, 16>(
+            nodes,
+            packets,
             prims,
             r,
-            &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
+            &Fused::prepare(&RayBoxes::new(r), &offsets, nodes),
             out,
         ),
-        None => run_avx2_plain::<Q, P>(b, prims, r, out),
+        None => run_avx2_plain::<Q, P, 16>(nodes, packets, prims, r, out),
     }
 }
 
@@ -128,8 +138,9 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 /// with its caller's instruction set.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
+unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
+    nodes: &[WideNode<W>],
+    packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
     out: &mut Q::Out,
@@ -139,15 +150,16 @@ unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     use box_test::Fused;
     use lanes::Avx;
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false, SHALLOW_STACK>(
-            b,
+        Q::run::<Fused<Avx>, false, SHALLOW_STACK, W>(
+            nodes,
+            packets,
             prims,
             r,
-            &Fused::prepare(&RayBoxes::new(r), &offsets, &b.nodes),
+            &Fused::prepare(&RayBoxes::new(r), &offsets, nodes),
             out,
         )
     } else {
-        run_avx2_plain::<Q, P>(b, prims, r, out)
+        run_avx2_plain::<Q, P, W>(nodes, packets, prims, r, out)
     }
 }
 
@@ -157,8 +169,9 @@ unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 #[target_feature(enable = "avx2,fma")]
 #[inline(never)]
 #[cold]
-unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
+unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
+    nodes: &[WideNode<W>],
+    packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
     out: &mut Q::Out,
@@ -166,15 +179,16 @@ unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     use lanes::Avx;
     // (Made here, not passed in: a reference to it would make the common path store it.)
     let rb = RayBoxes::new(r);
+    let prepared = Slab::prepare(&rb, nodes);
     if r.zero_axes.any() {
-        Q::run::<Slab<Avx>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
+        Q::run::<Slab<Avx>, true, SHALLOW_STACK, W>(nodes, packets, prims, r, &prepared, out)
     } else {
-        Q::run::<Slab<Avx>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
+        Q::run::<Slab<Avx>, false, SHALLOW_STACK, W>(nodes, packets, prims, r, &prepared, out)
     }
 }
 
-/// The paths without AVX2, shallow trees only; out of line, so that their frames do not
-/// add to the AVX2 path's caller.
+/// The paths without AVX2 (nodes of sixteen), shallow trees only; out of line, so that
+/// their frames do not add to the AVX2 path's caller.
 #[inline(never)]
 unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     b: &Bvh,
@@ -184,38 +198,53 @@ unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 ) -> Q::Answer {
     let zero = r.zero_axes.any();
     let rb = RayBoxes::new(r);
+    let (nodes, packets) = (&b.nodes16[..], &b.packets[..]);
     match b.isa {
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 if zero => {
-            Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
-        }
+        Isa::Sse2 if zero => Q::run::<Slab<lanes::Sse>, true, SHALLOW_STACK, 16>(
+            nodes,
+            packets,
+            prims,
+            r,
+            &Slab::prepare(&rb, nodes),
+            out,
+        ),
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
+        Isa::Sse2 => Q::run::<Slab<lanes::Sse>, false, SHALLOW_STACK, 16>(
+            nodes,
+            packets,
+            prims,
+            r,
+            &Slab::prepare(&rb, nodes),
+            out,
+        ),
+        _ if zero => {
+            Q::run::<Slab<f32>, true, SHALLOW_STACK, 16>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out)
         }
-        _ if zero => Q::run::<Slab<f32>, true, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
-        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
+        _ => Q::run::<Slab<f32>, false, SHALLOW_STACK, 16>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out),
     }
 }
 
-/// Trees deeper than [`traverse::SHALLOW_LEVELS`] (only pathological inputs make them):
+/// Trees deeper than [`traverse::shallow_levels`] (only pathological inputs make them):
 /// the plain box test (it takes every ray; every box test enters the same boxes the
 /// answers depend on, so the answers are the same) with the large stack.
 #[cold]
 #[inline(never)]
-unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    b: &Bvh,
+unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
+    isa: Isa,
+    nodes: &[WideNode<W>],
+    packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
     let rb = RayBoxes::new(r);
-    match b.isa {
+    match isa {
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
-            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out)
+            Q::run::<Slab<lanes::Sse>, true, DEEP_STACK, W>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out)
         }
-        _ => Q::run::<Slab<f32>, true, DEEP_STACK>(b, prims, r, &Slab::prepare(&rb, &b.nodes), out),
+        _ => Q::run::<Slab<f32>, true, DEEP_STACK, W>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out),
     }
 }
 
@@ -228,22 +257,26 @@ impl Bvh {
         r: &PreparedRay,
         out: &mut Q::Out,
     ) -> Q::Answer {
-        if self.nodes.is_empty() {
+        if self.node_count() == 0 {
             return Q::nothing(out);
         }
         // SAFETY: node and packet references were built by `wide::collapse` for these
-        // primitives, with at most `MAX_LEVELS` levels (asserted at build) and at most
-        // `SHALLOW_LEVELS` unless `deep`; the AVX2 path is only taken when the CPU has
-        // AVX2 and FMA (`isa` checked at build); SSE2 is part of x86-64.
+        // primitives, in nodes of `isa.node_width()` children (`nodes8` for AVX2,
+        // `nodes16` else), with at most `MAX_LEVELS` levels (asserted at build) and at
+        // most `shallow_levels` unless `deep`; the AVX2 and AVX-512 paths are only taken
+        // when the CPU has them (`isa` checked at build); SSE2 is part of x86-64.
         unsafe {
             if self.deep {
-                return run_deep::<Q, P>(self, prims, r, out);
+                return match self.isa.node_width() {
+                    8 => run_deep::<Q, P, 8>(self.isa, &self.nodes8, &self.packets, prims, r, out),
+                    _ => run_deep::<Q, P, 16>(self.isa, &self.nodes16, &self.packets, prims, r, out),
+                };
             }
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx512 => run_avx512::<Q, P>(self, prims, r, out),
+                Isa::Avx512 => run_avx512::<Q, P>(&self.nodes16, &self.packets, prims, r, out),
                 #[cfg(target_arch = "x86_64")]
-                Isa::Avx2 => run_avx2::<Q, P>(self, prims, r, out),
+                Isa::Avx2 => run_avx2::<Q, P>(&self.nodes8, &self.packets, prims, r, out),
                 _ => run_portable::<Q, P>(self, prims, r, out),
             }
         }

@@ -36,7 +36,7 @@ use super::ray_lanes::RayLanes;
 use super::ray_sphere::SphereRays;
 use super::ray_triangle::{self, ShearedRays};
 use super::traverse::leaf_packets;
-use super::wide::{WideNode, EMPTY, LEAF, WIDTH};
+use super::wide::{WideNode, EMPTY, LEAF, MAX_WIDTH};
 use crate::accel::{PrimitiveSet, SEARCH_SLACK};
 use crate::hit::Hit;
 use crate::ray::{PreparedRay, Ray};
@@ -44,12 +44,12 @@ use std::mem::MaybeUninit;
 
 /// The most rays a packet holds (AVX-512's sixteen lanes).
 pub const MAX_PACKET: usize = 16;
-// A visit pushes every entered child (up to `WIDTH`) and pops one: fewer than `WIDTH`
-// more per level. Packets only walk trees of at most `SHALLOW_LEVELS` levels (deeper
-// ones trace their rays one by one, see `Bvh::in_packets`): sized for the 112 levels any
-// tree may have, the entry distances alone took 57 KB of stack, probed page by page on
-// every packet.
-const STACK_SIZE: usize = WIDTH * super::traverse::SHALLOW_LEVELS;
+// A visit pushes every entered child (up to the node width W) and pops one: fewer than W
+// more per level. Packets only walk trees of at most `STACK_SIZE / W` levels (deeper
+// ones trace their rays one by one, see `Bvh::in_packets` and `traverse::shallow_levels`):
+// sized for the 112 levels any tree may have, the entry distances alone took 57 KB of
+// stack, probed page by page on every packet.
+pub(super) const STACK_SIZE: usize = MAX_WIDTH * super::traverse::SHALLOW_LEVELS;
 /// A leaf reached by at least this many rays of a packet that shares its axes is tested
 /// triangle by triangle across the rays; by fewer, ray by ray (four triangles at a time).
 const LANE_LEAF_RAYS: u32 = 3;
@@ -195,14 +195,14 @@ impl Prepared<'_> {
 /// of at most [`super::traverse::SHALLOW_LEVELS`] levels.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
-    nodes: &[WideNode],
+pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized, const W: usize>(
+    nodes: &[WideNode<W>],
     packets: &[Packet],
     prims: &P,
     rays: &[Ray],
     states: &mut [Q::State],
 ) -> u32 {
-    traverse::<super::ray_lanes::Rays8, Q, P>(nodes, packets, prims, rays, states)
+    traverse::<super::ray_lanes::Rays8, Q, P, W>(nodes, packets, prims, rays, states)
 }
 
 /// Walks a packet of 1 to 16 rays through the tree with AVX-512 lanes; returns the rays
@@ -213,22 +213,22 @@ pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
 /// tree built for `prims`, of at most [`super::traverse::SHALLOW_LEVELS`] levels.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
-pub unsafe fn traverse_avx512<Q: PacketQuery, P: PrimitiveSet + ?Sized>(
-    nodes: &[WideNode],
+pub unsafe fn traverse_avx512<Q: PacketQuery, P: PrimitiveSet + ?Sized, const W: usize>(
+    nodes: &[WideNode<W>],
     packets: &[Packet],
     prims: &P,
     rays: &[Ray],
     states: &mut [Q::State],
 ) -> u32 {
-    traverse::<super::ray_lanes::Rays16, Q, P>(nodes, packets, prims, rays, states)
+    traverse::<super::ray_lanes::Rays16, Q, P, W>(nodes, packets, prims, rays, states)
 }
 
 /// Walks the packet `rays` (1 to `L::N` rays) through the tree; `states` start as
 /// [`PacketQuery::start`] and end as the answers, except for the rays returned, which
 /// cannot travel in a packet.
 #[inline(always)]
-unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
-    nodes: &[WideNode],
+unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized, const W: usize>(
+    nodes: &[WideNode<W>],
     packets: &[Packet],
     prims: &P,
     rays: &[Ray],
@@ -321,16 +321,20 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
             }
             continue;
         }
-        let node = &*nodes.as_ptr().cast::<u8>().add(e.reference as usize).cast::<WideNode>();
+        let node = &*nodes
+            .as_ptr()
+            .cast::<u8>()
+            .add(e.reference as usize)
+            .cast::<WideNode<W>>();
         // The children some active ray enters; for closest-hit queries keyed by the entry
         // distance of the lowest such ray and ordered so that the nearest is popped first
         // (any-hit queries pop the last slot first, as single rays do). When the rays
         // allow it, the interval test first drops the slots no ray can enter.
         let base = sp;
-        let mut bound = [0f32; WIDTH];
+        let mut bound = [0f32; W];
         let slots = match &lanes.frustum {
             Some(f) => f.children(node, packet_limit, &mut bound),
-            None => (1 << WIDTH) - 1,
+            None => (1 << W) - 1,
         };
         for c in Bits(slots) {
             let child = node.child[c];
@@ -356,9 +360,9 @@ unsafe fn traverse<L: RayLanes, Q: PacketQuery, P: PrimitiveSet + ?Sized>(
                 continue;
             }
             let (hits, n) = if l.rows.is_some() {
-                l.enters::<true>(node, c, limit)
+                l.enters::<true, W>(node, c, limit)
             } else {
-                l.enters::<false>(node, c, limit)
+                l.enters::<false, W>(node, c, limit)
             };
             let m = hits & mask;
             if m == 0 {

@@ -9,7 +9,7 @@ use std::mem::MaybeUninit;
 
 use super::box_test::BoxTest;
 use super::packet::Packet;
-use super::wide::{WideNode, FIRST_MASK, LEAF, PACKET_SHIFT, WIDTH};
+use super::wide::{WideNode, FIRST_MASK, LEAF, MAX_WIDTH, PACKET_SHIFT};
 use crate::accel::search_limit;
 use crate::accel::PrimitiveSet;
 use crate::hit::Hit;
@@ -19,15 +19,30 @@ use crate::ray::PreparedRay;
 /// splits below depth 48 halve every node), and each wide level takes at least one
 /// binary level. [`super::Bvh`] asserts it at build time.
 pub const MAX_LEVELS: usize = 112;
-/// The node levels of the trees the fast paths are compiled for: every tree a real scene
-/// makes (a billion triangles in balanced nodes of sixteen need 7; the dragons' trees
-/// have 7 and 9). Deeper trees take the paths with [`DEEP_STACK`].
+/// The node levels of the trees of nodes of sixteen the fast paths are compiled for:
+/// every tree a real scene makes (a billion triangles in balanced nodes of sixteen need
+/// 7; the dragons' trees have 7 and 9). Deeper trees take the paths with [`DEEP_STACK`].
+/// Trees of nodes of eight may have more levels in the same stacks: [`shallow_levels`].
 pub const SHALLOW_LEVELS: usize = 16;
 
-/// Stack entries for trees of `levels` node levels: each visit leaves at most
-/// `WIDTH - 1` entries for the levels below it.
+/// Stack entries for trees of `levels` node levels of the widest nodes: each visit
+/// leaves at most `MAX_WIDTH - 1` entries for the levels below it.
 const fn stack_entries(levels: usize) -> usize {
-    (WIDTH - 1) * levels
+    (MAX_WIDTH - 1) * levels
+}
+
+/// The most node levels a tree of nodes of `width` children may have to take the fast
+/// paths: what their single-ray stack ([`SHALLOW_STACK`], `width - 1` entries a level)
+/// and their packets' stack (`width` a level) hold. 16 for nodes of sixteen, 32 for
+/// nodes of eight.
+pub const fn shallow_levels(width: usize) -> usize {
+    let single = SHALLOW_STACK / (width - 1);
+    let packets = super::ray_packet::STACK_SIZE / width;
+    if single < packets {
+        single
+    } else {
+        packets
+    }
 }
 /// The stack of the fast paths: 1.9 KB. A stack sized for [`MAX_LEVELS`] (6 KB) made
 /// every query's frame span two pages, behind a stack probe, and made a query that
@@ -39,7 +54,7 @@ pub const DEEP_STACK: usize = stack_entries(MAX_LEVELS);
 /// it is popped, after the nearer subtree, they have arrived (single rays and packets).
 /// Four lines, of a node's seven: asking for all seven measured no better.
 #[inline(always)]
-pub(super) unsafe fn prefetch(nodes: &[WideNode], packets: &[Packet], reference: u32) {
+pub(super) unsafe fn prefetch<const W: usize>(nodes: &[WideNode<W>], packets: &[Packet], reference: u32) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
@@ -58,9 +73,9 @@ pub(super) unsafe fn prefetch(nodes: &[WideNode], packets: &[Packet], reference:
 
 /// The node at byte offset `offset` (see [`super::wide::LEAF`]).
 #[inline(always)]
-unsafe fn node_at(nodes: &[WideNode], offset: u32) -> &WideNode {
+unsafe fn node_at<const W: usize>(nodes: &[WideNode<W>], offset: u32) -> &WideNode<W> {
     debug_assert!((offset as usize) < std::mem::size_of_val(nodes));
-    &*nodes.as_ptr().cast::<u8>().add(offset as usize).cast::<WideNode>()
+    &*nodes.as_ptr().cast::<u8>().add(offset as usize).cast::<WideNode<W>>()
 }
 
 /// The packets of leaf reference `reference`.
@@ -121,10 +136,10 @@ fn entry(dist: f32, reference: u32) -> u64 {
 ///
 /// # Safety
 /// The nodes and packets must be one tree built for `prims`, of at most
-/// `STACK / (WIDTH - 1)` node levels, and `T`'s instructions available.
+/// `STACK / (W - 1)` node levels, and `T`'s instructions available.
 #[inline(always)]
-pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize>(
-    nodes: &[WideNode],
+pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize, const W: usize>(
+    nodes: &[WideNode<W>],
     packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
@@ -137,12 +152,12 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
     let mut limit = search_limit(t_max);
     let mut stack = [const { MaybeUninit::<u64>::uninit() }; STACK];
     let mut sp = 0usize;
-    let mut dist = [0.0f32; WIDTH];
+    let mut dist = [0.0f32; W];
     let mut cur = 0u32;
     loop {
         if cur & LEAF == 0 {
             let node = node_at(nodes, cur);
-            let mask = T::test::<ZERO>(node, rb, limit, &mut dist);
+            let mask = T::test::<ZERO, W>(node, rb, limit, &mut dist);
             if mask != 0 {
                 let first = mask.trailing_zeros() as usize;
                 let rest = mask & (mask - 1);
@@ -202,8 +217,8 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
 
 /// Whether anything in the tree blocks `r` ([`closest`]'s conditions).
 #[inline(always)]
-pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize>(
-    nodes: &[WideNode],
+pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize, const W: usize>(
+    nodes: &[WideNode<W>],
     packets: &[Packet],
     prims: &P,
     r: &PreparedRay,
@@ -212,12 +227,12 @@ pub unsafe fn occluded<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, c
     let t_max = r.ray.t_max;
     let mut stack = [const { MaybeUninit::<u32>::uninit() }; STACK];
     let mut sp = 0usize;
-    let mut dist = [0.0f32; WIDTH];
+    let mut dist = [0.0f32; W];
     let mut cur = 0u32;
     loop {
         if cur & LEAF == 0 {
             let node = node_at(nodes, cur);
-            let mut mask = T::test::<ZERO>(node, rb, search_limit(t_max), &mut dist);
+            let mut mask = T::test::<ZERO, W>(node, rb, search_limit(t_max), &mut dist);
             if mask != 0 {
                 // The highest slot next, the others popped in descending order after it
                 // (one consistent order; measured 2% faster than lowest first).

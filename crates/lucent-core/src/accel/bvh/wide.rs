@@ -1,7 +1,8 @@
-//! Second stage of the BVH build: the binary tree collapsed into 16-wide nodes.
+//! Second stage of the BVH build: the binary tree collapsed into nodes of `W` children,
+//! 16 or 8 ([`super::Isa::node_width`]).
 //!
 //! Each wide node takes the place of a binary node and adopts the roots of a cut through
-//! its subtree as its (up to sixteen) children; each child is a leaf (a subtree of at most
+//! its subtree as its (up to `W`) children; each child is a leaf (a subtree of at most
 //! eight primitives, one or two packets) or a wide node of its own. Which cut, and which
 //! subtrees become leaves, is the plan of [`super::collapse_plan`]: the least expected
 //! cost by the surface area heuristic. The node stores its children's boxes as
@@ -13,6 +14,9 @@
 //! nodes of eight (on an AMD EPYC, Zen 4, paired): single rays 1.02–1.06× faster on
 //! the dragons with the AVX-512 build, about the same with AVX2 alone (0.96–1.01×),
 //! packets of rays the same, the same memory per triangle (see `docs/performance.md`).
+//! Why eight with AVX2: on a CPU without AVX-512 (an AMD EPYC, Zen 3) nodes of eight,
+//! one AVX2 group a visit, traced primary rays 1.01–1.09× faster and the others about
+//! the same (sixteen vector registers do not hold a ray's constants and two groups).
 //!
 //! Leaves become runs of four-wide packets, laid out in the order traversal meets them.
 //! With more than one thread, large subtrees are laid out by tasks of their own, each as
@@ -24,7 +28,9 @@ use super::collapse_plan::{Plan, MERGE};
 use super::packet::{Packet, LANES};
 use crate::accel::PrimitiveSet;
 
-pub const WIDTH: usize = 16;
+/// The most children a node has: sixteen for AVX-512 (and the portable paths), eight for
+/// AVX2 (see [`super::Isa::node_width`]).
+pub const MAX_WIDTH: usize = 16;
 /// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`;
 /// an interior child is the byte offset of its node in the node array.
 pub const LEAF: u32 = 1 << 31;
@@ -33,39 +39,39 @@ pub const FIRST_MASK: u32 = (1 << PACKET_SHIFT) - 1;
 /// An unused slot; its box is empty (min > max), so no ray ever enters it.
 pub const EMPTY: u32 = 0;
 
-/// Sixteen child boxes and references. `bounds[0..3]` are the minima along x, y, z,
+/// `W` child boxes and references. `bounds[0..3]` are the minima along x, y, z,
 /// `bounds[3..6]` the maxima; lane `i` belongs to child `i`.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-pub struct WideNode {
-    pub bounds: [[f32; WIDTH]; 6],
-    pub child: [u32; WIDTH],
+pub struct WideNode<const W: usize = MAX_WIDTH> {
+    pub bounds: [[f32; W]; 6],
+    pub child: [u32; W],
 }
 
 const _: () = assert!(MAX_LEAF.div_ceil(LANES) <= 1 << (31 - PACKET_SHIFT));
 
-impl WideNode {
-    pub const EMPTY: WideNode = WideNode {
+impl<const W: usize> WideNode<W> {
+    pub const EMPTY: WideNode<W> = WideNode {
         bounds: [
-            [f32::INFINITY; WIDTH],
-            [f32::INFINITY; WIDTH],
-            [f32::INFINITY; WIDTH],
-            [f32::NEG_INFINITY; WIDTH],
-            [f32::NEG_INFINITY; WIDTH],
-            [f32::NEG_INFINITY; WIDTH],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
         ],
-        child: [EMPTY; WIDTH],
+        child: [EMPTY; W],
     };
 }
 
-pub struct WideTree {
-    pub nodes: Vec<WideNode>,
+pub struct WideTree<const W: usize> {
+    pub nodes: Vec<WideNode<W>>,
     pub packets: Vec<Packet>,
 }
 
 /// How many node levels the tree has (a root whose children are all leaves: 1); what
 /// the traversal stack must hold.
-pub fn levels(nodes: &[WideNode]) -> usize {
+pub fn levels<const W: usize>(nodes: &[WideNode<W>]) -> usize {
     if nodes.is_empty() {
         return 0;
     }
@@ -74,7 +80,7 @@ pub fn levels(nodes: &[WideNode]) -> usize {
     let mut pending = vec![(0usize, 1usize)];
     while let Some((offset, level)) = pending.pop() {
         deepest = deepest.max(level);
-        let node = &nodes[offset / std::mem::size_of::<WideNode>()];
+        let node = &nodes[offset / std::mem::size_of::<WideNode<W>>()];
         for &child in &node.child {
             if child != EMPTY && child & LEAF == 0 {
                 pending.push((child as usize, level + 1));
@@ -84,9 +90,10 @@ pub fn levels(nodes: &[WideNode]) -> usize {
     deepest
 }
 
-pub fn collapse<P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree {
+/// The tree in nodes of at most `W` children.
+pub fn collapse<const W: usize, P: PrimitiveSet + ?Sized>(tree: &BinaryTree, prims: &P) -> WideTree<W> {
     let threads = rayon::current_num_threads();
-    let plan = Plan::new(tree);
+    let plan = Plan::new(tree, W);
     let plan = &plan;
     let parts = match tree.nodes.first() {
         None => vec![],
@@ -141,13 +148,13 @@ const PARALLEL_REFS: usize = 4096;
 /// for each packet, the references it will hold (`tree.refs[start..start + count]`).
 /// Its interior references count (in bytes) from its first node, its leaf references
 /// from its first packet; [`join_parts`] moves them to their places.
-struct Part {
-    nodes: Vec<WideNode>,
+struct Part<const W: usize> {
+    nodes: Vec<WideNode<W>>,
     packet_refs: Vec<(u32, u32)>,
 }
 
-impl Part {
-    fn with_capacity(nodes: usize, packets: usize) -> Part {
+impl<const W: usize> Part<W> {
+    fn with_capacity(nodes: usize, packets: usize) -> Part<W> {
         Part {
             nodes: crate::huge_pages::vec_with_capacity(nodes),
             packet_refs: Vec::with_capacity(packets),
@@ -174,7 +181,7 @@ fn subtree_refs(tree: &BinaryTree, n: u32) -> usize {
 /// The wide subtree standing for interior binary node `b` as consecutive parts: the
 /// nodes and packets of [`collapse_node`], in its order, with large child subtrees
 /// collapsed on the pool's threads.
-fn collapse_parallel(tree: &BinaryTree, plan: &Plan, b: u32, parallel: usize) -> Vec<Part> {
+fn collapse_parallel<const W: usize>(tree: &BinaryTree, plan: &Plan, b: u32, parallel: usize) -> Vec<Part<W>> {
     let refs = subtree_refs(tree, b);
     if refs <= parallel {
         // About one node for every six references, one packet for every three.
@@ -185,7 +192,7 @@ fn collapse_parallel(tree: &BinaryTree, plan: &Plan, b: u32, parallel: usize) ->
     let (children, count) = plan.children(tree, b);
     let children = &children[..count];
     let leaves: Vec<Option<(u32, u32)>> = children.iter().map(|&c| leaf_refs(tree, plan, c)).collect();
-    let subtrees: Vec<Vec<Part>> = {
+    let subtrees: Vec<Vec<Part<W>>> = {
         use rayon::prelude::*;
         let interior: Vec<u32> = (children.iter().zip(&leaves))
             .filter_map(|(&c, leaf)| leaf.is_none().then_some(c))
@@ -216,7 +223,7 @@ fn collapse_parallel(tree: &BinaryTree, plan: &Plan, b: u32, parallel: usize) ->
                 if let Some(last) = parts.last() {
                     packets_before += last.packet_refs.len();
                 }
-                let offset = byte_offset(nodes_before);
+                let offset = byte_offset::<W>(nodes_before);
                 for part in subtrees.next().expect("a subtree for each interior child") {
                     nodes_before += part.nodes.len();
                     packets_before += part.packet_refs.len();
@@ -238,7 +245,7 @@ fn collapse_parallel(tree: &BinaryTree, plan: &Plan, b: u32, parallel: usize) ->
 
 /// The parts put together: each part's references moved by the nodes and packets before
 /// it, the nodes written in place on the pool's threads.
-fn join_parts(mut parts: Vec<Part>) -> (Vec<WideNode>, Vec<(u32, u32)>) {
+fn join_parts<const W: usize>(mut parts: Vec<Part<W>>) -> (Vec<WideNode<W>>, Vec<(u32, u32)>) {
     if parts.len() <= 1 {
         return parts.pop().map_or_else(Default::default, |p| (p.nodes, p.packet_refs));
     }
@@ -261,7 +268,7 @@ fn join_parts(mut parts: Vec<Part>) -> (Vec<WideNode>, Vec<(u32, u32)>) {
             let k = node_base.partition_point(|&b| b <= i) - 1;
             let mut node = parts[k].nodes[i - node_base[k]];
             for c in &mut node.child {
-                *c = relocate(*c, node_base[k], packet_base[k]);
+                *c = relocate::<W>(*c, node_base[k], packet_base[k]);
             }
             node
         }));
@@ -275,14 +282,14 @@ fn join_parts(mut parts: Vec<Part>) -> (Vec<WideNode>, Vec<(u32, u32)>) {
 
 /// A child reference of a part whose first node and first packet are `node_base` and
 /// `packet_base` of the whole tree, as the whole tree's reference.
-fn relocate(c: u32, node_base: usize, packet_base: usize) -> u32 {
+fn relocate<const W: usize>(c: u32, node_base: usize, packet_base: usize) -> u32 {
     if c == EMPTY {
         EMPTY
     } else if c & LEAF != 0 {
         let first = (c & FIRST_MASK) as usize + packet_base;
         (c & !FIRST_MASK) | checked_first(first)
     } else {
-        byte_offset(c as usize / std::mem::size_of::<WideNode>() + node_base)
+        byte_offset::<W>(c as usize / std::mem::size_of::<WideNode<W>>() + node_base)
     }
 }
 
@@ -298,8 +305,8 @@ fn checked_first(first: usize) -> u32 {
 /// The reference to the node at `index`: interior children are referenced by byte
 /// offset, so traversal needs no multiplication between loading a reference and
 /// loading the node.
-fn byte_offset(index: usize) -> u32 {
-    let offset = index * std::mem::size_of::<WideNode>();
+fn byte_offset<const W: usize>(index: usize) -> u32 {
+    let offset = index * std::mem::size_of::<WideNode<W>>();
     assert!(
         offset < LEAF as usize,
         "too many nodes for the BVH's 31-bit node offsets"
@@ -307,7 +314,7 @@ fn byte_offset(index: usize) -> u32 {
     offset as u32
 }
 
-fn set_child(node: &mut WideNode, slot: usize, child: &BinaryNode, reference: u32) {
+fn set_child<const W: usize>(node: &mut WideNode<W>, slot: usize, child: &BinaryNode, reference: u32) {
     let (lo, hi) = (child.bounds.min, child.bounds.max);
     for axis in 0..3 {
         node.bounds[axis][slot] = lo[axis];
@@ -342,7 +349,7 @@ fn push_packets(start: u32, count: u32, first: usize, packet_refs: &mut Vec<(u32
 }
 
 /// Lays out the packets of a binary leaf; returns its slot reference.
-fn leaf_slot(leaf: &BinaryNode, out: &mut Part) -> u32 {
+fn leaf_slot<const W: usize>(leaf: &BinaryNode, out: &mut Part<W>) -> u32 {
     let Kind::Leaf { start, count } = leaf.kind else {
         unreachable!("a leaf")
     };
@@ -361,14 +368,14 @@ fn leaf_refs(tree: &BinaryTree, plan: &Plan, c: u32) -> Option<(u32, u32)> {
 
 /// Builds the wide node standing for interior binary node `b`, its subtree after it;
 /// returns its index.
-fn collapse_node(tree: &BinaryTree, plan: &Plan, b: u32, out: &mut Part) -> u32 {
+fn collapse_node<const W: usize>(tree: &BinaryTree, plan: &Plan, b: u32, out: &mut Part<W>) -> u32 {
     let (children, count) = plan.children(tree, b);
     let me = out.nodes.len();
     out.nodes.push(WideNode::EMPTY);
     for (slot, &c) in children[..count].iter().enumerate() {
         let reference = match leaf_refs(tree, plan, c) {
             Some((start, n)) => push_packets(start, n, out.packet_refs.len(), &mut out.packet_refs),
-            None => byte_offset(collapse_node(tree, plan, c, out) as usize),
+            None => byte_offset::<W>(collapse_node(tree, plan, c, out) as usize),
         };
         set_child(&mut out.nodes[me], slot, &tree.nodes[c as usize], reference);
     }
