@@ -366,9 +366,15 @@ pub fn run_one(
             samples: samples.clone(),
             ..header(&job)
         };
+        // A signal meanwhile waits for the checkpoint (up to 30 s, as for the partial
+        // render saved after it), and goes on waiting for that save.
+        signals::saving(true);
         match partial.write(film, kept, &extras) {
             Ok(()) => wrote_partial = true,
             Err(e) => eprintln!("lucent: warning: checkpoint not written: {e}"),
+        }
+        if !cancel.load(Ordering::Relaxed) {
+            signals::saving(false);
         }
     };
     let checkpoint = args.checkpoint.map(std::time::Duration::from_secs_f64);
@@ -508,6 +514,9 @@ pub fn run_one(
             bytes: state.encode(),
         });
     }
+    // (A signal from here on ends the run at once; one during a checkpoint's write, which
+    // ended such runs too, lets the checkpoint finish and saves the render's samples.)
+    signals::writing_final(true);
     if let Err(e) = write_all(&files) {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;

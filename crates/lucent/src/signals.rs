@@ -2,20 +2,30 @@
 //! flag between pixels and between samples, the run saves the samples of the passes it
 //! finished (a partial image and a state beside the output, never over it) and ends with
 //! exit code 130 (143 for SIGTERM); should a single sample take longer, the run ends
-//! anyway a second later (or once the partial render is saved, at most 30 s). During the
-//! write of the final output, and at a second signal, the run ends at once. Every way
+//! anyway a second later (or once a checkpoint being written and the partial render are
+//! saved, at most 30 s). During the write of the final output, and at a second signal,
+//! the run ends at once. Every way
 //! out removes the temporary file of an output being written, so an existing output is
 //! left as it was.
 
 use std::sync::atomic::{AtomicBool, AtomicI32, Ordering};
 use std::time::Duration;
 
-use lucent_io::resources::output::{remove_temporary_files_and_exit, writing};
+use lucent_io::resources::output::remove_temporary_files_and_exit;
 use signal_hook::consts::{SIGINT, SIGTERM};
 
 static CANCEL: AtomicBool = AtomicBool::new(false);
 static SIGNAL: AtomicI32 = AtomicI32::new(0);
 static SAVING: AtomicBool = AtomicBool::new(false);
+static WRITING_FINAL: AtomicBool = AtomicBool::new(false);
+
+/// Whether the run is writing its final outputs: a signal then ends it at once (the way
+/// out of a write that does not finish, to a FIFO nobody reads). Checkpoints and partial
+/// renders are not this: a signal during one lets it finish, and the run saves its
+/// samples as after any other signal.
+pub fn writing_final(on: bool) {
+    WRITING_FINAL.store(on, Ordering::Relaxed);
+}
 
 /// Whether the run is saving a partial render after a signal (the one-second limit then
 /// waits for it, up to 30 s).
@@ -42,7 +52,7 @@ pub fn install() {
         for (count, sig) in signals.forever().enumerate() {
             SIGNAL.store(sig, Ordering::Relaxed);
             CANCEL.store(true, Ordering::Relaxed);
-            if count > 0 || writing() {
+            if count > 0 || WRITING_FINAL.load(Ordering::Relaxed) {
                 stop_now();
             }
             // The run stops cleanly within a second (or once its partial render is

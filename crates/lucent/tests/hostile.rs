@@ -479,6 +479,54 @@ fn an_interrupted_write_leaves_no_temporary_file() {
     panic!("the write was never caught in progress");
 }
 
+/// A signal while a checkpoint is being written lets the checkpoint finish and saves the
+/// render's samples (it used to end the run at once, as during the final write, and say
+/// "nothing written").
+#[test]
+fn a_signal_during_a_checkpoints_write_saves_the_samples() {
+    let dir = workdir("checkpoint-write");
+    // An empty scene renders fast; its 1536² partial image and state take long enough to
+    // write to be caught in progress.
+    let scene = "size 1536 1536\ncamera 0 0 5 0 0 0 0 1 0 45\nintegrator pathtracer\nspp 1000000\n";
+    fs::write(dir.join("s.test"), scene).unwrap();
+    for _attempt in 0..5 {
+        for name in ["big.partial.exr", "big.partial.lstate"] {
+            let _ = fs::remove_file(dir.join(name));
+        }
+        let child = Command::new(bin())
+            .args(["render", "s.test", "-o", "big.exr", "-q", "--checkpoint", "0.2"])
+            .current_dir(&dir)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let pid = child.id() as i32;
+        let start = Instant::now();
+        let mut seen = false;
+        while start.elapsed() < seconds(60) && !seen {
+            // A later checkpoint's files (not the probes, before the render, of whether
+            // the outputs can be made).
+            seen = dir.join("big.partial.lstate").exists() && !temporary_files(&dir).is_empty();
+            if !seen {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+        }
+        if seen {
+            // SAFETY: signalling our own child.
+            unsafe { libc::kill(pid, libc::SIGINT) };
+        }
+        let r = finish(child, seconds(60));
+        assert!(temporary_files(&dir).is_empty());
+        if seen && r.code == Some(130) {
+            says(&r, "continue with: lucent render s.test");
+            assert!(dir.join("big.partial.lstate").exists());
+            assert!(!dir.join("big.exr").exists());
+            return;
+        }
+    }
+    panic!("no checkpoint's write was caught in progress");
+}
+
 // ---- 4. inputs without end ----
 
 #[test]

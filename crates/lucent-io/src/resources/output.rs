@@ -259,11 +259,6 @@ fn unlink_all(list: &[CString]) {
     }
 }
 
-/// Whether an output is being written now (a temporary file exists).
-pub fn writing() -> bool {
-    TEMPORARY.try_lock().map_or(true, |list| !list.is_empty())
-}
-
 /// A temporary file beside its target, removed unless it is renamed over it.
 struct TemporaryFile {
     path: PathBuf,
