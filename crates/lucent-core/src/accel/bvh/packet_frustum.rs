@@ -1,12 +1,13 @@
-//! A packet's rays bounded by intervals, and the node test that culls a node's sixteen
-//! children for the whole packet at once (interval arithmetic, as in Wald, Boulos and
+//! A packet's rays bounded by intervals, and the node test that culls a node's children
+//! for the whole packet at once (interval arithmetic, as in Wald, Boulos and
 //! Shirley, "Ray Tracing Deformable Scenes Using Dynamic Bounding Volume Hierarchies",
 //! 2007). When every ray of a packet moves the same way along each axis, all their
 //! origins lie in `[O_lo, O_hi]` and all their reciprocal directions in `[R_lo, R_hi]`
 //! (one sign) per axis; a child box that no ray in those intervals can enter is dropped
-//! with two eight-wide tests, before [`super::ray_packet`] tests the boxes left ray by
-//! ray. Coherent packets (camera rays of a tile) enter one or two of a node's sixteen
-//! children, so most per-ray box tests are never made.
+//! with eight-wide tests (two for a node of sixteen, one for a node of eight), before
+//! [`super::ray_packet`] tests the boxes left ray by ray. Coherent packets (camera rays of
+//! a tile) enter one or two of a node's children, so most per-ray box tests are never
+//! made.
 //!
 //! **Conservative.** For ray `i` and a plane `b` along an axis its exact slab distance is
 //! `t = (b − oᵢ)/dᵢ`, and its lane holds `rᵢ = fl(1/dᵢ) = (1/dᵢ)(1 + δ)`, `|δ| ≤ u`

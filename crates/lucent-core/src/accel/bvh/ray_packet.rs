@@ -2,8 +2,8 @@
 //! through the wide BVH together, one SIMD lane per ray: eight with AVX2, sixteen with
 //! AVX-512 ([`super::ray_lanes`]). At a node, when the rays all move the same way along
 //! each axis, the interval test of [`super::packet_frustum`] first drops the children no
-//! ray of the packet can enter (camera rays enter one or two of sixteen); a closest-hit
-//! packet goes on into the inner nodes it keeps with all its rays. Each other child box
+//! ray of the packet can enter (camera rays enter one or two of a node's children); a
+//! closest-hit packet goes on into the inner nodes it keeps with all its rays. Each other child box
 //! is tested against every active ray of the packet; a child that some ray enters is
 //! pushed with the mask of those rays. At a leaf reached by several rays that share
 //! their dominant axis, each triangle is tested against all of them at once
