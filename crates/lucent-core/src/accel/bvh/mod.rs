@@ -92,7 +92,7 @@ impl Isa {
     /// AVX2-wide groups, four SSE ones), except for AVX2, which tests a node of eight
     /// in one group. (Measured on an AMD EPYC without AVX-512, Zen 3: nodes of eight
     /// 1.01–1.09× faster on primary rays than nodes of sixteen tested as two groups,
-    /// 0.99–1.08× on the other sets and packets; see docs/performance.md.)
+    /// 0.98–1.08× on the other sets and packets; see docs/performance.md.)
     pub fn node_width(self) -> usize {
         match self {
             Isa::Avx2 => 8,
