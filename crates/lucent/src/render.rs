@@ -517,7 +517,10 @@ pub fn run_one(
     // (A signal from here on ends the run at once; one during a checkpoint's write, which
     // ended such runs too, lets the checkpoint finish and saves the render's samples.)
     signals::writing_final(true);
-    if let Err(e) = write_all(&files) {
+    let written = write_all(&files);
+    // (The next scene of the run renders, and is interrupted, as this one was.)
+    signals::writing_final(false);
+    if let Err(e) = written {
         eprintln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }

@@ -284,6 +284,38 @@ fn merging_refuses_other_scenes_overlaps_gaps_and_damaged_files() {
     );
 }
 
+/// Ctrl-C in the second scene of a run saves that scene's samples (the first scene's
+/// final write must not leave the run ending at once on the next signal).
+#[test]
+fn ctrl_c_in_a_later_scene_of_a_run_saves_its_samples() {
+    use std::time::{Duration, Instant};
+    let dir = workdir("interrupt-later");
+    fs::write(dir.join("a.test"), scene(INTEGRATORS[2])).unwrap();
+    fs::write(
+        dir.join("b.test"),
+        scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000"),
+    )
+    .unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(["render", "a.test", "b.test", "-q", "--checkpoint", "0.3"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !dir.join("b.partial.lstate").exists() {
+        assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint of b.test");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    // SAFETY: signalling our own child.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130));
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(said.contains("wrote b.partial.png and b.partial.lstate"), "{said}");
+    assert!(dir.join("a.png").exists() && !dir.join("b.png").exists());
+}
+
 #[test]
 fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
     use std::time::{Duration, Instant};
