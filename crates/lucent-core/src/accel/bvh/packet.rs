@@ -229,6 +229,13 @@ impl Packet {
         // hold NaN, whose sign is arbitrary; their distance is NaN and fails the range test.)
         let mixed = _mm_movemask_ps(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w))) as u32;
         let inside = !mixed & !any_zero & 0xF;
+        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
+        // No lane inside its triangle and none to leave to the scalar code but those whose
+        // edge functions rounded to zero: the distance would decide nothing (most packets
+        // a ray reaches end here).
+        if inside | other == 0 {
+            return LaneHits::none(any_zero);
+        }
         let det = _mm_add_ps(_mm_add_ps(u, v), w);
         let t_scaled = _mm_add_ps(
             _mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(sz, az)), _mm_mul_ps(v, _mm_mul_ps(sz, bz))),
@@ -246,7 +253,6 @@ impl Packet {
         let accepted = _mm_movemask_ps(accept) as u32 & inside;
         // Flagged lanes: non-triangles (NaN corners, so NaN edge functions) always go to the
         // scalar code, checked triangles only with a hit the SIMD test accepted.
-        let other = _mm_movemask_ps(_mm_castsi128_ps(_mm_load_si128(self.ids.as_ptr().cast()))) as u32;
         let scalar = if other == 0 {
             any_zero
         } else {
