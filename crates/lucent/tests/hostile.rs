@@ -441,6 +441,25 @@ fn the_runs_own_inputs_are_never_overwritten() {
     assert!(temporary_files(&dir).is_empty());
 }
 
+/// Sends SIGINT to `child` as soon as `ready()` holds (polled every 200 µs for up to a
+/// minute, to catch a write in progress), then waits up to `limit` for it to end: whether
+/// the signal was sent, and the run.
+fn interrupt_when(child: Child, limit: Duration, mut ready: impl FnMut() -> bool) -> (bool, Run) {
+    let start = Instant::now();
+    let mut seen = false;
+    while start.elapsed() < seconds(60) && !seen {
+        seen = ready();
+        if !seen {
+            std::thread::sleep(Duration::from_micros(200));
+        }
+    }
+    if seen {
+        // SAFETY: signalling our own child.
+        unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    }
+    (seen, finish(child, limit))
+}
+
 #[test]
 fn an_interrupted_write_leaves_no_temporary_file() {
     let dir = workdir("write");
@@ -455,20 +474,7 @@ fn an_interrupted_write_leaves_no_temporary_file() {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        let pid = child.id() as i32;
-        let start = Instant::now();
-        let mut seen = false;
-        while start.elapsed() < seconds(60) && !seen {
-            seen = !temporary_files(&dir).is_empty();
-            if !seen {
-                std::thread::sleep(Duration::from_micros(200));
-            }
-        }
-        if seen {
-            // SAFETY: signalling our own child.
-            unsafe { libc::kill(pid, libc::SIGINT) };
-        }
-        let r = finish(child, seconds(30));
+        let (seen, r) = interrupt_when(child, seconds(30), || !temporary_files(&dir).is_empty());
         if seen && r.code == Some(130) {
             assert!(temporary_files(&dir).is_empty(), "{:?}", temporary_files(&dir));
             assert!(!dir.join("big.exr").exists());
@@ -500,22 +506,11 @@ fn a_signal_during_a_checkpoints_write_saves_the_samples() {
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        let pid = child.id() as i32;
-        let start = Instant::now();
-        let mut seen = false;
-        while start.elapsed() < seconds(60) && !seen {
-            // A later checkpoint's files (not the probes, before the render, of whether
-            // the outputs can be made).
-            seen = dir.join("big.partial.lstate").exists() && !temporary_files(&dir).is_empty();
-            if !seen {
-                std::thread::sleep(Duration::from_micros(200));
-            }
-        }
-        if seen {
-            // SAFETY: signalling our own child.
-            unsafe { libc::kill(pid, libc::SIGINT) };
-        }
-        let r = finish(child, seconds(60));
+        // A later checkpoint's files (not the probes, before the render, of whether the
+        // outputs can be made).
+        let (seen, r) = interrupt_when(child, seconds(60), || {
+            dir.join("big.partial.lstate").exists() && !temporary_files(&dir).is_empty()
+        });
         assert!(temporary_files(&dir).is_empty());
         if seen && r.code == Some(130) {
             says(&r, "continue with: lucent render s.test");

@@ -39,6 +39,25 @@ fn fails(dir: &Path, args: &[&str], says: &str) {
 }
 
 /// A small scene with glass, a sphere, a floor and a quad light, in `integrator`.
+/// Starts a render in `dir` whose standard error the test reads when it has ended.
+fn start(dir: &Path, args: &[&str]) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_lucent"))
+        .args(args)
+        .current_dir(dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits (up to a minute) for a running render to write `path`; `what` names it if it never does.
+fn wait_for(path: &Path, what: &str) {
+    let start = std::time::Instant::now();
+    while !path.exists() {
+        assert!(start.elapsed() < std::time::Duration::from_secs(60), "{what}");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
 fn scene(integrator: &str) -> String {
     format!(
         "size 40 30\n{integrator}\ngamma 2.2\ncamera 0 1 3 0 0.8 0 0 1 0 45\nambient 0.02 0.02 0.02\n\
@@ -288,7 +307,6 @@ fn merging_refuses_other_scenes_overlaps_gaps_and_damaged_files() {
 /// final write must not leave the run ending at once on the next signal).
 #[test]
 fn ctrl_c_in_a_later_scene_of_a_run_saves_its_samples() {
-    use std::time::{Duration, Instant};
     let dir = workdir("interrupt-later");
     fs::write(dir.join("a.test"), scene(INTEGRATORS[2])).unwrap();
     fs::write(
@@ -296,17 +314,8 @@ fn ctrl_c_in_a_later_scene_of_a_run_saves_its_samples() {
         scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000"),
     )
     .unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args(["render", "a.test", "b.test", "-q", "--checkpoint", "0.3"])
-        .current_dir(&dir)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !dir.join("b.partial.lstate").exists() {
-        assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint of b.test");
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    let child = start(&dir, &["render", "a.test", "b.test", "-q", "--checkpoint", "0.3"]);
+    wait_for(&dir.join("b.partial.lstate"), "no checkpoint of b.test");
     // SAFETY: signalling our own child.
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
     let out = child.wait_with_output().unwrap();
@@ -324,18 +333,12 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
     let text = scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000");
     fs::write(dir.join("s.test"), &text).unwrap();
     fs::write(dir.join("out.exr"), b"an earlier render").unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args(["render", "s.test", "-o", "out.exr", "-q", "--checkpoint", "0.5"])
-        .current_dir(&dir)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = start(
+        &dir,
+        &["render", "s.test", "-o", "out.exr", "-q", "--checkpoint", "0.5"],
+    );
     // A checkpoint appears while the render runs.
-    let start = Instant::now();
-    while !dir.join("out.partial.lstate").exists() {
-        assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint");
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    wait_for(&dir.join("out.partial.lstate"), "no checkpoint");
     std::thread::sleep(Duration::from_millis(700));
     // SAFETY: signalling our own child.
     unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
@@ -386,15 +389,15 @@ fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
 /// it: a resubmission takes an existing state for a finished task.
 #[test]
 fn a_killed_task_leaves_no_state_but_a_partial_one_beside_it() {
-    use std::time::{Duration, Instant};
     let dir = workdir("killed-task");
     fs::write(
         dir.join("s.test"),
         scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000"),
     )
     .unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_lucent"))
-        .args([
+    let child = start(
+        &dir,
+        &[
             "render",
             "s.test",
             "-o",
@@ -404,16 +407,9 @@ fn a_killed_task_leaves_no_state_but_a_partial_one_beside_it() {
             "t.lstate",
             "--checkpoint",
             "0.5",
-        ])
-        .current_dir(&dir)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !dir.join("t.partial.lstate").exists() {
-        assert!(start.elapsed() < Duration::from_secs(60), "no checkpoint");
-        std::thread::sleep(Duration::from_millis(50));
-    }
+        ],
+    );
+    wait_for(&dir.join("t.partial.lstate"), "no checkpoint");
     // SAFETY: signalling our own child.
     unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
     let out = child.wait_with_output().unwrap();
