@@ -41,9 +41,39 @@ impl Ray {
     }
 }
 
+/// A coordinate axis. As an index it is known to be below three, so indexing a
+/// three-element array or a vector by it needs no bounds check (the traversal's leaf
+/// test indexes by the ray's axes at every call).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Axis {
+    X = 0,
+    Y = 1,
+    Z = 2,
+}
+
+impl Axis {
+    pub const ALL: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
+
+    /// `0`, `1` or `2`.
+    #[inline(always)]
+    pub const fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The component of `v` along this axis.
+    #[inline(always)]
+    pub fn of(self, v: &Vec3A) -> f32 {
+        AsRef::<[f32; 3]>::as_ref(v)[self.index()]
+    }
+}
+
 /// `[kx, ky]` for the dominant axis `kz` (index `2·kz`), and exchanged for a direction
 /// that points down `kz` (index `2·kz + 1`): the next two axes in cyclic order.
-pub(crate) const AXES_AROUND: [[usize; 2]; 6] = [[1, 2], [2, 1], [2, 0], [0, 2], [0, 1], [1, 0]];
+pub(crate) const AXES_AROUND: [[Axis; 2]; 6] = {
+    use Axis::*;
+    [[Y, Z], [Z, Y], [Z, X], [X, Z], [X, Y], [Y, X]]
+};
 
 /// A ray with what every box and triangle test needs, computed once per ray: the
 /// reciprocal direction for slab tests and the shear of the watertight triangle test
@@ -58,9 +88,9 @@ pub struct PreparedRay {
     /// The axes along which the ray does not move (`dir` component ±0).
     pub zero_axes: BVec3A,
     /// Axis permutation: `kz` is the dominant axis of the direction.
-    pub kx: usize,
-    pub ky: usize,
-    pub kz: usize,
+    pub kx: Axis,
+    pub ky: Axis,
+    pub kz: Axis,
     /// The origin's components along `kx`, `ky`, `kz` (picked once per ray, not once
     /// per triangle: choosing by a per-ray axis is a branch or a round trip through memory).
     pub origin_k: [f32; 3],
@@ -100,18 +130,19 @@ impl PreparedRay {
             };
             inv_dir = Vec3A::new(fix(d.x, inv_dir.x), fix(d.y, inv_dir.y), fix(d.z, inv_dir.z));
         }
-        let kz = max_abs_axis(d);
+        let k = max_abs_axis(d);
         // Keep the winding of the projected triangle: exchange kx and ky when looking
         // down −z. The axes and the components are picked without a branch: for
         // incoherent rays each branch on the axis was mispredicted a third of the time,
-        // and made a query that misses the scene about 30 % slower.
-        let negative = d.cmplt(Vec3A::ZERO).bitmask() as usize >> kz & 1;
-        let [kx, ky] = AXES_AROUND[2 * kz + negative];
-        // Each vector spilled once, its components read by index (`& 3`: in bounds).
-        let [o, dk, inv] = [ray.origin, d, inv_dir].map(|v| [v.x, v.y, v.z, 0.0]);
+        // and made a query that misses the scene about 30 % slower. (Components are read
+        // by index from each vector's own bytes: building arrays of them took a shuffle
+        // per component.)
+        let negative = d.cmplt(Vec3A::ZERO).bitmask() as usize >> k & 1;
+        let [kx, ky] = AXES_AROUND[2 * k + negative];
+        let kz = Axis::ALL[k];
         // `1/d[kz]` is `inv_dir[kz]`: the dominant component of a non-zero direction is
         // not zero, so its reciprocal was not replaced.
-        let sz = inv[kz & 3];
+        let sz = kz.of(&inv_dir);
         PreparedRay {
             ray,
             inv_dir,
@@ -119,9 +150,9 @@ impl PreparedRay {
             kx,
             ky,
             kz,
-            origin_k: [o[kx & 3], o[ky & 3], o[kz & 3]],
-            sx: dk[kx & 3] * sz,
-            sy: dk[ky & 3] * sz,
+            origin_k: [kx.of(&ray.origin), ky.of(&ray.origin), kz.of(&ray.origin)],
+            sx: kx.of(&d) * sz,
+            sy: ky.of(&d) * sz,
             sz,
         }
     }

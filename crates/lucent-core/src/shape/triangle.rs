@@ -28,7 +28,7 @@ pub fn intersect(r: &PreparedRay, p0: Vec3A, p1: Vec3A, p2: Vec3A, t_max: f32) -
     let a = p0 - o;
     let b = p1 - o;
     let c = p2 - o;
-    let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+    let (kx, ky, kz) = (r.kx.index(), r.ky.index(), r.kz.index());
     let ax = a[kx] - r.sx * a[kz];
     let ay = a[ky] - r.sy * a[kz];
     let bx = b[kx] - r.sx * b[kz];

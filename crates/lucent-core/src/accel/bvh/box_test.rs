@@ -13,8 +13,9 @@
 //!   the next one. Its error is not relative to the result (`o/d` may dwarf the
 //!   difference), so the ray carries two offsets, `o/d ± c` with `c = 2⁻¹⁸·|o/d|`, and a
 //!   far reciprocal widened by `1 + 2⁻¹⁹`: [`FmaOffsets`] states the bound (the same
-//!   for every lane width). Rays with an infinite constant, a negative `t_min` or an
-//!   axis they do not move along take the plain AVX test.
+//!   for every lane width). Rays whose constants may overflow (single rays: `|o/d|` or
+//!   `|1/d|` at least half the largest float; packets: any constant infinite), a
+//!   negative `t_min` or an axis they do not move along take the plain AVX test.
 //!
 //! Axes along which the ray does not move are decided by where the origin lies (a
 //! separate instantiation, since such rays are rare).
@@ -107,6 +108,8 @@ pub struct FmaOffsets {
 impl FmaOffsets {
     pub(super) const OFFSET: f32 = 1.0 / (1u32 << 18) as f32;
     pub(super) const WIDENING: f32 = 1.0 + 1.0 / (1u32 << 19) as f32;
+    /// The largest `|o/d|` and `|1/d|` the constants are made for.
+    const LIMIT: f32 = f32::MAX / 2.0;
 
     /// The constants, or `None` for rays that must take the plain test.
     #[inline(always)]
@@ -117,10 +120,14 @@ impl FmaOffsets {
         // As whole vectors (see `RayBoxes::new`): the same operations lane by lane.
         let inv = r.inv_dir;
         let p = r.ray.origin * inv;
-        let c = p.abs() * Self::OFFSET;
+        let p_abs = p.abs();
+        let c = p_abs * Self::OFFSET;
         let (near, far, inv_far) = (p + c, p - c, inv * Self::WIDENING);
-        let finite = inv.is_finite_mask() & near.is_finite_mask() & far.is_finite_mask() & inv_far.is_finite_mask();
-        finite.all().then_some(FmaOffsets { near, far, inv_far })
+        // Below half the largest float, `o/d` and `1/d` stay finite with their offset and
+        // widening (each grows by less than 2⁻¹⁷); a NaN fails the comparison. Two
+        // comparisons instead of four finiteness tests.
+        let small = p_abs.cmplt(Vec3A::splat(Self::LIMIT)) & inv.abs().cmplt(Vec3A::splat(Self::LIMIT));
+        small.all().then_some(FmaOffsets { near, far, inv_far })
     }
 }
 

@@ -196,7 +196,7 @@ impl Packet {
     #[inline(always)]
     unsafe fn triangle_lanes_sse(&self, r: &PreparedRay, t_max: f32) -> LaneHits {
         use std::arch::x86_64::*;
-        let (kx, ky, kz) = (r.kx, r.ky, r.kz);
+        let (kx, ky, kz) = (r.kx.index(), r.ky.index(), r.kz.index());
         let [ox, oy, oz] = r.origin_k.map(|c| _mm_set1_ps(c));
         let (sx, sy, sz) = (_mm_set1_ps(r.sx), _mm_set1_ps(r.sy), _mm_set1_ps(r.sz));
         let ld = |c: usize, axis: usize| _mm_load_ps(self.p[c][axis].as_ptr());

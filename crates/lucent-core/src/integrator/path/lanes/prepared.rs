@@ -6,7 +6,7 @@ use std::arch::x86_64::*;
 
 use super::vector::*;
 use crate::math::Vec3A;
-use crate::ray::{PreparedRay, Ray, AXES_AROUND, EPSILON};
+use crate::ray::{Axis, PreparedRay, Ray, AXES_AROUND, EPSILON};
 
 /// Rays of all lanes with what traversal needs of them ([`PreparedRay::new`], made in
 /// the lanes: the same numbers), one array per field.
@@ -57,7 +57,7 @@ impl PreparedLanes {
         // `AXES_AROUND[2 kz + down]`, as two tables of lanes.
         let row = _mm256_add_epi32(_mm256_add_epi32(kz, kz), down);
         let table = |k: usize| {
-            let t = |r: usize| AXES_AROUND[r.min(5)][k] as i32;
+            let t = |r: usize| AXES_AROUND[r.min(5)][k].index() as i32;
             _mm256_setr_epi32(t(0), t(1), t(2), t(3), t(4), t(5), 0, 0)
         };
         let kx = _mm256_permutevar8x32_epi32(table(0), row);
@@ -94,8 +94,9 @@ impl PreparedLanes {
     #[inline]
     pub(super) fn get(&self, i: usize) -> PreparedRay {
         let dir = self.dir.get(i);
-        let kz = self.kz[i] as usize;
-        let [kx, ky] = AXES_AROUND[2 * kz + self.down[i] as usize];
+        let k = self.kz[i] as usize;
+        let [kx, ky] = AXES_AROUND[2 * k + self.down[i] as usize];
+        let kz = Axis::ALL[k];
         let shear = self.shear.get(i);
         let origin_k = self.origin_k.get(i);
         PreparedRay {
