@@ -255,7 +255,7 @@ struct LeafQuery<'a, P: ?Sized> {
 /// after another). The node loop then pops the entry left on top, as it would have.
 /// Against testing one leaf a call (AMD EPYC, Zen 3, CPU time, paired): the 100k
 /// dragon's diffuse rays 1.056 [0.997–1.088], its primary rays 0.997 [0.968–1.154]
-/// (12 rounds each); 13 and 20 instructions a ray fewer.
+/// (12 rounds each); 19 and 28 instructions a ray fewer (callgrind).
 ///
 /// Why out of line: the box test keeps twelve vectors of ray constants, a limit and
 /// `t_min`; with the packet test inlined in the same loop, LLVM kept most of them on the
