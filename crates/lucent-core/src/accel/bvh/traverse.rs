@@ -132,6 +132,12 @@ fn entry(dist: f32, reference: u32) -> u64 {
     (dist.to_bits() as u64) << 32 | reference as u64
 }
 
+/// The entry distance of stack entry `e` ([`entry`]).
+#[inline(always)]
+fn entry_distance(e: u64) -> f32 {
+    f32::from_bits((e >> 32) as u32)
+}
+
 /// The closest hit of `r` in the tree, into `best` (the caller's answer, so that the hit
 /// is not copied out of a local of this function).
 ///
@@ -215,7 +221,7 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
             let e = stack.get_unchecked(sp).assume_init();
             // Keep an entry whose box starts at (or, by rounding, just beyond) the closest
             // hit: it may hold a tie.
-            if f32::from_bits((e >> 32) as u32) <= limit {
+            if entry_distance(e) <= limit {
                 cur = e as u32;
                 break;
             }
@@ -290,7 +296,7 @@ unsafe fn closest_leaves_avx2<P: PrimitiveSet + ?Sized>(
                 return t_max;
             }
             let e = *stack.add(*sp - 1);
-            if f32::from_bits((e >> 32) as u32) > limit {
+            if entry_distance(e) > limit {
                 *sp -= 1;
                 continue;
             }
