@@ -5,7 +5,8 @@
 
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 mod common;
 
@@ -38,26 +39,26 @@ fn fails(dir: &Path, args: &[&str], says: &str) {
     assert!(err.contains(says), "lucent {args:?}: expected «{says}» in {err}");
 }
 
-/// A small scene with glass, a sphere, a floor and a quad light, in `integrator`.
 /// Starts a render in `dir` whose standard error the test reads when it has ended.
-fn start(dir: &Path, args: &[&str]) -> std::process::Child {
+fn start(dir: &Path, args: &[&str]) -> Child {
     Command::new(env!("CARGO_BIN_EXE_lucent"))
         .args(args)
         .current_dir(dir)
-        .stderr(std::process::Stdio::piped())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap()
 }
 
 /// Waits (up to a minute) for a running render to write `path`; `what` names it if it never does.
 fn wait_for(path: &Path, what: &str) {
-    let start = std::time::Instant::now();
+    let start = Instant::now();
     while !path.exists() {
-        assert!(start.elapsed() < std::time::Duration::from_secs(60), "{what}");
-        std::thread::sleep(std::time::Duration::from_millis(50));
+        assert!(start.elapsed() < Duration::from_secs(60), "{what}");
+        std::thread::sleep(Duration::from_millis(50));
     }
 }
 
+/// A small scene with glass, a sphere, a floor and a quad light, in `integrator`.
 fn scene(integrator: &str) -> String {
     format!(
         "size 40 30\n{integrator}\ngamma 2.2\ncamera 0 1 3 0 0.8 0 0 1 0 45\nambient 0.02 0.02 0.02\n\
@@ -327,7 +328,6 @@ fn ctrl_c_in_a_later_scene_of_a_run_saves_its_samples() {
 
 #[test]
 fn ctrl_c_saves_the_finished_samples_and_the_render_resumes_from_them() {
-    use std::time::{Duration, Instant};
     let dir = workdir("interrupt");
     // Far more samples than the test waits for; an earlier final image must survive.
     let text = scene(INTEGRATORS[2]).replace("spp 16", "spp 1000000");
