@@ -162,6 +162,9 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
     let mut sp = 0usize;
     let mut dist = [0.0f32; W];
     let mut cur = 0u32;
+    // Made once a ray, not at every leaf call.
+    #[cfg(target_arch = "x86_64")]
+    let leaves = LeafQuery { packets, prims, r };
     loop {
         if cur & LEAF == 0 {
             let node = node_at(nodes, cur);
@@ -204,7 +207,6 @@ pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, co
         } else {
             #[cfg(target_arch = "x86_64")]
             if W == 8 {
-                let leaves = LeafQuery { packets, prims, r };
                 t_max = closest_leaves_avx2(&leaves, cur, t_max, stack.as_ptr().cast(), &mut sp, best);
             } else {
                 closest_leaf(packets, prims, r, cur, &mut t_max, best);
