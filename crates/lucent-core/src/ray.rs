@@ -39,6 +39,14 @@ impl Ray {
     pub fn at(&self, t: f32) -> Vec3A {
         self.origin + self.dir * t
     }
+
+    /// Whether the ray describes a line: a finite origin and a finite, non-zero
+    /// direction. Structures find nothing along any other ray
+    /// ([`crate::accel::Accelerator`]).
+    #[inline]
+    pub fn is_line(&self) -> bool {
+        self.origin.is_finite() && self.dir.is_finite() && self.dir != Vec3A::ZERO
+    }
 }
 
 /// A coordinate axis. As an index it is known to be below three, so indexing a

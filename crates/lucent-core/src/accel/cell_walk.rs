@@ -36,6 +36,9 @@ impl<W: CellWalk + Send + Sync, P: PrimitiveSet + ?Sized> Accelerator<P> for W {
 
 pub fn closest_hit<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, r: &PreparedRay) -> Option<Hit> {
     let mut best: Option<Hit> = None;
+    if !r.ray.is_line() {
+        return best;
+    }
     let mut t_max = r.ray.t_max;
     Mailbox::with(w.prim_count(), |mailbox| {
         w.walk(r, |ids| {
@@ -58,6 +61,9 @@ pub fn closest_hit<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, r: &P
 
 pub fn occluded<P: PrimitiveSet + ?Sized>(w: &impl CellWalk, prims: &P, r: &PreparedRay) -> bool {
     let mut hit = false;
+    if !r.ray.is_line() {
+        return hit;
+    }
     Mailbox::with(w.prim_count(), |mailbox| {
         w.walk(r, |ids| {
             hit = ids

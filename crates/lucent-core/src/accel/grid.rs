@@ -167,8 +167,10 @@ impl CellWalk for Grid {
                 2
             };
             let exit = next_t[a];
-            // The closest hit lies in this cell, or the ray ends in it.
-            if limit < exit || exit > search_limit(ray.t_max) {
+            // The closest hit lies in this cell, or the ray ends in it; or no wall lies
+            // ahead at a finite distance (the nearest is along an axis the ray does not
+            // move along: every distance overflowed).
+            if limit < exit || exit > search_limit(ray.t_max) || step[a] == 0 {
                 return;
             }
             let n = c[a] as isize + step[a];

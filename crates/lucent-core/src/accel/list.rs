@@ -20,6 +20,9 @@ impl PrimitiveList {
 
 impl<P: PrimitiveSet + ?Sized> Accelerator<P> for PrimitiveList {
     fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit> {
+        if !r.ray.is_line() {
+            return None;
+        }
         let mut best: Option<Hit> = None;
         for &i in &self.indices {
             let t_max = best.map_or(r.ray.t_max, |b| b.t);
@@ -33,7 +36,7 @@ impl<P: PrimitiveSet + ?Sized> Accelerator<P> for PrimitiveList {
     }
 
     fn occluded(&self, prims: &P, r: &PreparedRay) -> bool {
-        self.indices.iter().any(|&i| prims.occludes(i, r, r.ray.t_max))
+        r.ray.is_line() && self.indices.iter().any(|&i| prims.occludes(i, r, r.ray.t_max))
     }
 
     fn memory_bytes(&self) -> usize {

@@ -104,6 +104,17 @@ pub fn is_bounded(b: &Aabb) -> bool {
 }
 
 /// A structure over the primitive set `P` it was built for.
+///
+/// A ray that is not a line ([`Ray::is_line`]: an infinite or NaN origin or direction
+/// component, or a zero direction) finds nothing in every structure, the list included.
+/// Such a ray has no answer to agree on, and its infinities and NaNs would turn the
+/// structures' own arithmetic against them: a box test whose distances are all NaN
+/// enters every slot, the empty ones too, and a walk through cells that never reaches
+/// the next wall would not end.
+///
+/// The answers are the list's for `t_min ≥ 0` (or NaN), as every ray the renderer traces
+/// has: the box tests' widening of exit distances is conservative for boxes ahead of the
+/// origin, not behind it.
 pub trait Accelerator<P: PrimitiveSet + ?Sized>: Send + Sync {
     /// The closest hit with `ray.t_min < t <= ray.t_max`.
     fn closest_hit(&self, prims: &P, r: &PreparedRay) -> Option<Hit>;

@@ -117,6 +117,79 @@ fn fans(rng: &mut Rng, eyes: usize, spread: f32, t_max: f32) -> Vec<Ray> {
     rays
 }
 
+/// Rays that are not lines (an infinite or NaN origin or direction component, or a zero
+/// direction) find nothing in any structure, alone or in a packet among rays that are;
+/// rays with odd limits (NaN, infinite, empty intervals; `t_min` never negative: see
+/// [`Accelerator`]) or directions of odd lengths get the list's answers. Before, a
+/// direction of infinite components made the BVH's box test (all its distances NaN)
+/// enter empty child slots, whose reference is the root's, until the traversal wrote past
+/// its stack; and the grid walked one cell for ever when no wall lay ahead.
+#[test]
+fn rays_that_are_not_lines_find_nothing_and_odd_rays_match_the_list() {
+    let (nan, inf) = (f32::NAN, f32::INFINITY);
+    let odd = [nan, inf, -inf];
+    // Small sets leave most child slots of a node empty; the large one fills them.
+    for n in [1, 3, 12, 40, 700] {
+        let prims = soup(n as u64, n);
+        let mut rng = Rng(n as u64 + 41);
+        // Coherent rows, so that packets form; every fifth ray made not a line: one, two
+        // or three components of its origin or direction odd, or its direction zero.
+        let mut rays = fans(&mut rng, 1, 15.0, inf);
+        for (k, r) in rays.iter_mut().enumerate().filter(|(k, _)| k % 5 == 0) {
+            let j = k / 5;
+            if j % 7 == 6 {
+                r.dir = Vec3A::ZERO;
+                continue;
+            }
+            let v = if j % 2 == 0 { &mut r.dir } else { &mut r.origin };
+            for c in 0..=(j / 2 % 3) {
+                v[(c + j / 6) % 3] = odd[(j / 3 + c) % 3];
+            }
+        }
+        let not_lines = rays.iter().filter(|r| !r.is_line()).count();
+        assert!(not_lines > 150, "{not_lines}");
+        // Odd limits, and directions far from unit length, eight rays from one origin at
+        // a time, so that each packet holds all of them (the fans fill whole packets). A
+        // NaN far limit among them made the packet's search limit NaN, and the other rays
+        // lost their hits.
+        assert_eq!(rays.len() % 8, 0);
+        for r in random_rays(&mut rng, 120, 15.0, 8.0) {
+            let odd_limits = |t_min, t_max| Ray::segment(r.origin, r.dir, t_min, t_max);
+            let scaled = |scale: f32| Ray::segment(r.origin, r.dir * scale, 0.0, inf);
+            rays.extend([
+                odd_limits(1e-4, nan),
+                odd_limits(nan, inf),
+                odd_limits(inf, inf),
+                odd_limits(2.0, 1.0),
+                scaled(1e-20),
+                scaled(1e-3),
+                scaled(1e20),
+                odd_limits(1e-4, nan),
+            ]);
+        }
+        check_against_list(&prims, &rays);
+        let list = PrimitiveList::new(&prims[..]);
+        for r in rays.iter().filter(|r| !r.is_line()) {
+            let r = PreparedRay::new(*r);
+            assert_eq!(list.closest_hit(&prims[..], &r), None);
+            assert!(!list.occluded(&prims[..], &r));
+        }
+        // A direction so short that the distance to every cell wall ahead overflows (the
+        // grid walked its first cell for ever): the queries end. (Their hits, at
+        // distances near the largest float, are not compared.)
+        let creep = PreparedRay::new(Ray::segment(
+            Vec3A::new(0.3, 0.2, 0.1),
+            Vec3A::new(1e-40, 0.0, 0.0),
+            0.0,
+            inf,
+        ));
+        for (_, accel) in structures(&prims) {
+            accel.closest_hit(&prims, &creep);
+            accel.occluded(&prims, &creep);
+        }
+    }
+}
+
 #[test]
 fn coherent_fans_of_rays_match_the_list() {
     for seed in 1..4 {

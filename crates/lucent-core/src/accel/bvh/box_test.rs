@@ -111,7 +111,9 @@ impl FmaOffsets {
     /// The largest `|o/d|` and `|1/d|` the constants are made for.
     const LIMIT: f32 = f32::MAX / 2.0;
 
-    /// The constants, or `None` for rays that must take the plain test.
+    /// The constants, or `None` for rays that must take the plain test — every ray that
+    /// is not a line among them ([`crate::ray::Ray::is_line`]; the callers' plain paths
+    /// answer those with nothing).
     #[inline(always)]
     pub fn new(r: &PreparedRay) -> Option<FmaOffsets> {
         if r.zero_axes.any() || !(r.ray.t_min >= 0.0) {
@@ -125,8 +127,14 @@ impl FmaOffsets {
         let (near, far, inv_far) = (p + c, p - c, inv * Self::WIDENING);
         // Below half the largest float, `o/d` and `1/d` stay finite with their offset and
         // widening (each grows by less than 2⁻¹⁷); a NaN fails the comparison. Two
-        // comparisons instead of four finiteness tests.
-        let small = p_abs.cmplt(Vec3A::splat(Self::LIMIT)) & inv.abs().cmplt(Vec3A::splat(Self::LIMIT));
+        // comparisons instead of four finiteness tests, and a third that `1/d` is not
+        // zero. So no ray that is not a line passes: an infinite direction component
+        // makes `1/d = 0` (and NaN distances, `inf · 0`), a NaN one `1/d = ±f32::MAX`
+        // (`PreparedRay::new`), an infinite or NaN origin component `o/d` infinite or NaN.
+        let inv_abs = inv.abs();
+        let small = p_abs.cmplt(Vec3A::splat(Self::LIMIT))
+            & inv_abs.cmplt(Vec3A::splat(Self::LIMIT))
+            & inv_abs.cmpgt(Vec3A::ZERO);
         small.all().then_some(FmaOffsets { near, far, inv_far })
     }
 }

@@ -35,8 +35,8 @@ pub(super) struct PacketLanes<L> {
     /// The rays as intervals, when they all move the same way along every axis.
     pub(super) frustum: Option<Frustum>,
     /// The rays that can travel in the packet: those with the fused box test's
-    /// constants (no axis they do not move along, every constant finite, `t_min ≥ 0`).
-    /// The others are traced alone.
+    /// constants (no axis they do not move along, a finite origin and direction, every
+    /// constant finite, `0 ≤ t_min ≤ t_max`). The others are traced alone.
     pub(super) ok: u32,
 }
 
@@ -50,7 +50,11 @@ pub(super) unsafe fn packet_lanes<L: RayLanes>(rays: &[Ray]) -> PacketLanes<L> {
     let dir = (&rays[0].dir as *const crate::math::Vec3A).cast::<f32>();
     let (zero, inf) = (L::splat(0.0), L::splat(f32::INFINITY));
     let t_min = L::gather(&rays[0].t_min, stride, last);
-    let mut ok = L::ALL >> (L::N - rays.len()) & zero.le(t_min);
+    // A NaN far limit would make the packet's largest search limit NaN, and its interval
+    // test drop every child for all the packet's rays; rays with an empty interval find
+    // nothing anyway. Both are traced alone.
+    let t_max = L::gather(&rays[0].t_max, stride, last);
+    let mut ok = L::ALL >> (L::N - rays.len()) & zero.le(t_min) & t_min.le(t_max);
     let (mut o, mut d, mut inv) = ([zero; 3], [zero; 3], [zero; 3]);
     let (mut near_off, mut far_off, mut inv_far) = ([zero; 3], [zero; 3], [zero; 3]);
     let mut negative = [0u32; 3];
@@ -64,7 +68,7 @@ pub(super) unsafe fn packet_lanes<L: RayLanes>(rays: &[Ray]) -> PacketLanes<L> {
         far_off[a] = p.sub(c);
         inv_far[a] = inv[a].mul(L::splat(FmaOffsets::WIDENING));
         ok &= !d[a].eq(zero);
-        for x in [o[a], inv[a], near_off[a], far_off[a], inv_far[a]] {
+        for x in [o[a], d[a], inv[a], near_off[a], far_off[a], inv_far[a]] {
             ok &= inf.gt(x.abs());
         }
         negative[a] = zero.gt(d[a]);

@@ -163,8 +163,9 @@ unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
     }
 }
 
-/// The rare rays the fused test cannot take; kept out of line so that the common path
-/// has the registers to itself.
+/// The rare rays the fused test cannot take, among them every ray that is not a line
+/// ([`crate::ray::Ray::is_line`]: it finds nothing; [`FmaOffsets::new`] sends them
+/// here); kept out of line so that the common path has the registers to itself.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 #[inline(never)]
@@ -177,6 +178,9 @@ unsafe fn run_avx2_plain<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
     out: &mut Q::Out,
 ) -> Q::Answer {
     use lanes::Avx;
+    if !r.ray.is_line() {
+        return Q::nothing(out);
+    }
     // (Made here, not passed in: a reference to it would make the common path store it.)
     let rb = RayBoxes::new(r);
     let prepared = Slab::prepare(&rb, nodes);
@@ -196,6 +200,9 @@ unsafe fn run_portable<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
+    if !r.ray.is_line() {
+        return Q::nothing(out);
+    }
     let zero = r.zero_axes.any();
     let rb = RayBoxes::new(r);
     let (nodes, packets) = (&b.nodes16[..], &b.packets[..]);
@@ -238,6 +245,9 @@ unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
+    if !r.ray.is_line() {
+        return Q::nothing(out);
+    }
     let rb = RayBoxes::new(r);
     match isa {
         #[cfg(target_arch = "x86_64")]
