@@ -50,9 +50,11 @@ impl Grid {
         let bounds = padded(&scene, pad);
         let ext = bounds.extent();
         // Flat scenes have no volume: give thin axes a token thickness for the estimate.
-        let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3));
-        let per_unit = (DENSITY * items.len() as f32 / (e.x * e.y * e.z)).cbrt();
-        let res = [0, 1, 2].map(|a| ((ext[a] * per_unit).round() as usize).clamp(1, MAX_RES));
+        // In f64: the volume of a scene a few 1e-13 across is below f32's range, and a
+        // zero volume made every axis MAX_RES cells (512³ cells for one primitive).
+        let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3)).as_dvec3();
+        let per_unit = (DENSITY as f64 * items.len() as f64 / (e.x * e.y * e.z)).cbrt();
+        let res = [0, 1, 2].map(|a| ((ext[a] as f64 * per_unit).round() as usize).clamp(1, MAX_RES));
         let cell_size = ext / Vec3A::new(res[0] as f32, res[1] as f32, res[2] as f32);
         let mut grid = Grid {
             bounds,
@@ -189,5 +191,22 @@ impl CellWalk for Grid {
 
     fn memory_bytes(&self) -> usize {
         (self.cell_start.len() + self.prim_ids.len()) * 4
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::test_sets::Triangles;
+
+    #[test]
+    fn a_scene_too_small_for_f32_volumes_gets_a_handful_of_cells() {
+        // All corners at one point (the padded box is about 1e-38 across: its volume is
+        // zero in f32), and a triangle a few 1e-14 across.
+        for size in [0.0f32, 3e-14] {
+            let tri = [Vec3A::ZERO, Vec3A::new(size, 0.0, 0.0), Vec3A::new(0.0, size, size)];
+            let grid = Grid::build(&Triangles(vec![tri; 2]));
+            assert!(grid.res.iter().product::<usize>() <= 8, "{size}: {:?}", grid.res);
+        }
     }
 }
