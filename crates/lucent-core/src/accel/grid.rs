@@ -50,8 +50,8 @@ impl Grid {
         let bounds = padded(&scene, pad);
         let ext = bounds.extent();
         // Flat scenes have no volume: give thin axes a token thickness for the estimate.
-        // In f64: the volume of a scene a few 1e-13 across is below f32's range, and a
-        // zero volume made every axis MAX_RES cells (512³ cells for one primitive).
+        // In f64: in f32 the volume of a scene under about 1e-13 across is subnormal, and
+        // under 1e-15 zero, which made every axis MAX_RES cells (512³ for one primitive).
         let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3)).as_dvec3();
         let per_unit = (DENSITY as f64 * items.len() as f64 / (e.x * e.y * e.z)).cbrt();
         let res = [0, 1, 2].map(|a| ((ext[a] as f64 * per_unit).round() as usize).clamp(1, MAX_RES));
