@@ -3,7 +3,9 @@
 //! Build: adaptive subdivision of the scene box. A cell with more than `MAX_LEAF`
 //! primitives is cut at its centre into eight octants, each primitive going to every
 //! octant it overlaps (the exact triangle–box test, on padded boxes), until cells are
-//! small enough, the depth limit is reached, or a cut stops separating anything.
+//! small enough, the depth limit is reached, a cut stops separating anything or
+//! separates too little (its octants hold four times the cell's primitives), or the
+//! tree holds [`MAX_ENTRIES_PER_PRIM`] entries a primitive.
 //!
 //! Traversal (in the spirit of Revelles, Ureña & Lastra 2000): inside a cell the ray
 //! starts in the octant that holds its entry point and crosses the three mid-planes in
@@ -20,6 +22,12 @@ use crate::ray::PreparedRay;
 
 const MAX_LEAF: usize = 8;
 const MAX_DEPTH: usize = 16;
+/// The most primitive entries the cells may hold, per primitive: once the tree holds
+/// more, the cells still to be cut become leaves. A primitive lies in every octant it
+/// touches, and cells thinner than their padding (a flat scene's, or around primitives
+/// that meet at a point) pass it to both halves, level after level: without a bound,
+/// nine primitives meeting at a point made 4¹⁶ cells.
+const MAX_ENTRIES_PER_PRIM: usize = 64;
 /// Each level pushes at most three octants.
 const STACK_SIZE: usize = 3 * MAX_DEPTH + 4;
 const INTERIOR: u32 = u32::MAX;
@@ -59,6 +67,8 @@ struct Builder<'a, P: ?Sized> {
     pad: f32,
     nodes: Vec<OctNode>,
     prim_ids: Vec<u32>,
+    /// Entries the tree may still add by cutting (see [`MAX_ENTRIES_PER_PRIM`]).
+    budget: usize,
 }
 
 impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
@@ -90,6 +100,14 @@ impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
             // Cutting separates nothing (every primitive spans the centre).
             return leaf(self, &items);
         }
+        // The children's entries replace this cell's. A cut that puts the cell's
+        // primitives into four children each, on average, separates too little to pay.
+        let entries = children.iter().map(Vec::len).sum::<usize>();
+        let growth = entries.saturating_sub(items.len());
+        if entries > 4 * items.len() || growth > self.budget {
+            return leaf(self, &items);
+        }
+        self.budget -= growth;
         let first = self.nodes.len();
         self.nodes[me] = OctNode {
             first: first as u32,
@@ -123,6 +141,7 @@ impl Octree {
             pad,
             nodes: vec![OctNode { first: 0, count: 0 }],
             prim_ids: Vec::new(),
+            budget: (MAX_ENTRIES_PER_PRIM - 1) * items.len(),
         };
         b.build(0, &bounds, items, 0);
         Octree {
@@ -210,5 +229,44 @@ impl CellWalk for Octree {
 
     fn memory_bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<OctNode>() + self.prim_ids.len() * 4
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::accel::test_sets::Triangles;
+    use crate::math::Vec3A;
+
+    #[test]
+    fn primitives_meeting_at_a_point_and_flat_scenes_make_bounded_trees() {
+        // Nine triangles meeting at one point and a sliver from it: every cut put them
+        // into four octants at once (the cells grew thinner than their padding), and the
+        // build made 4¹⁶ cells.
+        let p = Vec3A::splat(2.0);
+        let mut meet: Vec<[Vec3A; 3]> = (0..9).map(|_| [p; 3]).collect();
+        meet.push([p, Vec3A::new(2.0, 18.0, 2.0), p]);
+        // A flat grid of triangles: each cut through its plane passes every triangle to
+        // both halves.
+        let flat: Vec<[Vec3A; 3]> = (0..10_000)
+            .map(|k| {
+                let c = Vec3A::new((k % 100) as f32, (k / 100) as f32, 0.0);
+                [c, c + Vec3A::X, c + Vec3A::Y]
+            })
+            .collect();
+        for tris in [meet, flat] {
+            let n = tris.len();
+            let tree = Octree::build(&Triangles(tris));
+            assert!(
+                tree.prim_ids.len() <= MAX_ENTRIES_PER_PRIM * n,
+                "{} entries",
+                tree.prim_ids.len()
+            );
+            assert!(
+                tree.nodes.len() <= 8 * tree.prim_ids.len() + 1,
+                "{} nodes",
+                tree.nodes.len()
+            );
+        }
     }
 }
