@@ -22,8 +22,8 @@ use crate::ray::PreparedRay;
 
 const MAX_LEAF: usize = 8;
 const MAX_DEPTH: usize = 16;
-/// The most primitive entries the cells may hold, per primitive: once the tree holds
-/// more, the cells still to be cut become leaves. A primitive lies in every octant it
+/// The most primitive entries the cells may hold, per primitive: a cut that would take
+/// the tree past it makes a leaf instead. A primitive lies in every octant it
 /// touches, and cells thinner than their padding (a flat scene's, or around primitives
 /// that meet at a point) pass it to both halves, level after level: without a bound,
 /// nine primitives meeting at a point made 4¹⁶ cells.
@@ -240,9 +240,9 @@ mod tests {
 
     #[test]
     fn primitives_meeting_at_a_point_and_flat_scenes_make_bounded_trees() {
-        // Nine triangles meeting at one point and a sliver from it: every cut put them
+        // Nine triangles shrunk to one point and a sliver from it: every cut put them
         // into four octants at once (the cells grew thinner than their padding), and the
-        // build made 4¹⁶ cells.
+        // build made 4¹⁶ cells. (The flat grid made 174 entries a triangle.)
         let p = Vec3A::splat(2.0);
         let mut meet: Vec<[Vec3A; 3]> = (0..9).map(|_| [p; 3]).collect();
         meet.push([p, Vec3A::new(2.0, 18.0, 2.0), p]);
