@@ -431,6 +431,88 @@ mod tests {
         }
     }
 
+    /// A tree no build makes, to hold the traversal stacks to their bound: a chain of
+    /// `levels` nodes of `W` children whose boxes are all one cube, each node's first
+    /// child the next node and the others leaves (the last node's children all leaves),
+    /// every leaf the one packet. A ray through the cube enters every child of every node
+    /// and, the children being equally near, goes down the chain first (a node's
+    /// reference orders before a leaf's), leaving `W - 1` entries behind at each level
+    /// and pushing `W` more at the last: the most any tree of that many levels can ask of
+    /// the stack.
+    fn chain<const W: usize>(levels: usize) -> Vec<WideNode<W>> {
+        let size = std::mem::size_of::<WideNode<W>>() as u32;
+        (0..levels)
+            .map(|level| {
+                let mut node = WideNode::<W>::EMPTY;
+                for slot in 0..W {
+                    for axis in 0..3 {
+                        node.bounds[axis][slot] = -1.0;
+                        node.bounds[axis + 3][slot] = 1.0;
+                    }
+                    node.child[slot] = wide::LEAF; // packet 0, one packet
+                }
+                if level + 1 < levels {
+                    node.child[0] = (level as u32 + 1) * size;
+                }
+                node
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_stacks_hold_the_deepest_trees_each_path_takes() {
+        use crate::math::Vec3A;
+        let prims = Triangles(vec![[
+            Vec3A::new(-0.9, -0.9, 0.0),
+            Vec3A::new(0.9, -0.9, 0.0),
+            Vec3A::new(0.0, 0.9, 0.0),
+        ]]);
+        // Rows of rays through the cube onto the triangle: along z (the plain box test,
+        // for directions with zero components) and slightly tilted (the fused one).
+        let rays: Vec<Ray> = (0..32)
+            .map(|k| {
+                let o = Vec3A::new((k % 16) as f32 * 0.02 - 0.16, 0.1, -5.0);
+                let d = if k < 16 {
+                    Vec3A::Z
+                } else {
+                    Vec3A::new(0.01, -0.02, 1.0).normalize()
+                };
+                Ray::new(o, d)
+            })
+            .collect();
+        for isa in Isa::available() {
+            let width = isa.node_width();
+            let shallow = traverse::shallow_levels(width);
+            for levels in [shallow, shallow + 1, traverse::MAX_LEVELS] {
+                let (nodes16, nodes8) = match width {
+                    8 => (Vec::new(), chain::<8>(levels)),
+                    _ => (chain::<16>(levels), Vec::new()),
+                };
+                let bvh = Bvh {
+                    nodes16,
+                    nodes8,
+                    packets: vec![Packet::new(&prims, &[0])],
+                    isa,
+                    deep: levels > shallow,
+                };
+                assert_eq!(bvh.levels(), levels);
+                let mut hits = vec![None; rays.len()];
+                bvh.closest_hits(&prims, &rays, &mut hits);
+                let mut blocked = vec![false; rays.len()];
+                bvh.occluded_rays(&prims, &rays, &mut blocked);
+                for (i, ray) in rays.iter().enumerate() {
+                    let r = PreparedRay::new(*ray);
+                    let want = prims.intersect(0, &r, f32::INFINITY);
+                    assert!(want.is_some());
+                    assert_eq!(bvh.closest_hit(&prims, &r), want, "{isa:?}, {levels} levels, ray {i}");
+                    assert!(bvh.occluded(&prims, &r), "{isa:?}, {levels} levels, ray {i}");
+                    assert_eq!(hits[i], want, "{isa:?}, {levels} levels, packets, ray {i}");
+                    assert!(blocked[i], "{isa:?}, {levels} levels, packets, ray {i}");
+                }
+            }
+        }
+    }
+
     fn pool(threads: usize) -> rayon::ThreadPool {
         rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap()
     }

@@ -29,7 +29,7 @@ pub(super) trait Query<P: PrimitiveSet + ?Sized> {
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
     /// direction component, and the tree (`nodes`, `packets`) built for `prims` and at
-    /// most `STACK / (W - 1)` levels deep.
+    /// most [`traverse::levels_held`]`(STACK, W)` levels deep.
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize, const W: usize>(
         nodes: &[WideNode<W>],
         packets: &[Packet],

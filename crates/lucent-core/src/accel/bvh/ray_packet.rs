@@ -192,7 +192,7 @@ impl Prepared<'_> {
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA; `nodes` and `packets` must be a tree built for `prims`,
-/// of at most [`super::traverse::SHALLOW_LEVELS`] levels.
+/// of at most [`super::traverse::shallow_levels`]`(W)` levels.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized, const W: usize>(
@@ -210,7 +210,7 @@ pub unsafe fn traverse_avx2<Q: PacketQuery, P: PrimitiveSet + ?Sized, const W: u
 ///
 /// # Safety
 /// The CPU must have AVX-512 F, VL and BW, AVX2 and FMA; `nodes` and `packets` must be a
-/// tree built for `prims`, of at most [`super::traverse::SHALLOW_LEVELS`] levels.
+/// tree built for `prims`, of at most [`super::traverse::shallow_levels`]`(W)` levels.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 pub unsafe fn traverse_avx512<Q: PacketQuery, P: PrimitiveSet + ?Sized, const W: usize>(

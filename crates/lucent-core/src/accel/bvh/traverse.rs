@@ -26,18 +26,21 @@ pub const MAX_LEVELS: usize = 112;
 /// Trees of nodes of eight may have more levels in the same stacks: [`shallow_levels`].
 pub const SHALLOW_LEVELS: usize = 16;
 
-/// Stack entries for trees of `levels` node levels of the widest nodes: each visit
-/// leaves at most `MAX_WIDTH - 1` entries for the levels below it.
+/// Stack entries for trees of `levels` node levels of the widest nodes: a visit at the
+/// deepest level finds at most `MAX_WIDTH - 1` entries left by each level above it and
+/// pushes up to `MAX_WIDTH` (every child it enters) before it pops the nearest, so
+/// `(MAX_WIDTH - 1) · levels + 1` in all. ([`closest`] pushes before it pops;
+/// [`occluded`] keeps its next child out of the stack and needs one fewer.)
 const fn stack_entries(levels: usize) -> usize {
-    (MAX_WIDTH - 1) * levels
+    (MAX_WIDTH - 1) * levels + 1
 }
 
 /// The most node levels a tree of nodes of `width` children may have to take the fast
-/// paths: what their single-ray stack ([`SHALLOW_STACK`], `width - 1` entries a level)
-/// and their packets' stack (`width` a level) hold. 16 for nodes of sixteen, 32 for
-/// nodes of eight.
+/// paths: what their single-ray stack ([`SHALLOW_STACK`], `width - 1` entries a level
+/// and one more) and their packets' stack (`width` a level) hold. 16 for nodes of
+/// sixteen, 32 for nodes of eight.
 pub const fn shallow_levels(width: usize) -> usize {
-    let single = SHALLOW_STACK / (width - 1);
+    let single = levels_held(SHALLOW_STACK, width);
     let packets = super::ray_packet::STACK_SIZE / width;
     if single < packets {
         single
@@ -50,6 +53,12 @@ pub const fn shallow_levels(width: usize) -> usize {
 /// misses everything about 30 % slower.
 pub const SHALLOW_STACK: usize = stack_entries(SHALLOW_LEVELS);
 pub const DEEP_STACK: usize = stack_entries(MAX_LEVELS);
+
+/// The most node levels of nodes of `width` children a single-ray stack of `stack`
+/// entries holds ([`stack_entries`]'s bound the other way round).
+pub const fn levels_held(stack: usize, width: usize) -> usize {
+    (stack - 1) / (width - 1)
+}
 
 /// Asks for the first cache lines of a child that was pushed on the stack: by the time
 /// it is popped, after the nearer subtree, they have arrived (single rays and packets).
@@ -143,7 +152,7 @@ fn entry_distance(e: u64) -> f32 {
 ///
 /// # Safety
 /// The nodes and packets must be one tree built for `prims`, of at most
-/// `STACK / (W - 1)` node levels, and `T`'s instructions available (and AVX2 and FMA
+/// [`levels_held`]`(STACK, W)` node levels, and `T`'s instructions available (and AVX2 and FMA
 /// for nodes of eight, which only CPUs with them are given: [`super::Isa::node_width`]).
 #[inline(always)]
 pub unsafe fn closest<T: BoxTest, const ZERO: bool, P: PrimitiveSet + ?Sized, const STACK: usize, const W: usize>(
