@@ -116,6 +116,8 @@ pub fn open_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<(File,
 pub fn read_input(path: &Path, limit: u64, inputs: &mut Inputs) -> Result<Vec<u8>, String> {
     let (file, size) = open_input(path, limit, inputs)?;
     let mut bytes = Vec::new();
+    // (In the `lucent` binary an allocation the system refuses ends the run before this
+    // can answer, with exit code 2 and a message of its own: see `lucent`'s `oom.rs`.)
     bytes
         .try_reserve_exact(size as usize)
         .map_err(|_| format!("no memory for the file's {}", self::bytes(size)))?;

@@ -296,10 +296,12 @@ impl TemporaryFile {
             };
             let path = target.with_file_name(tmp_name);
             let registered = path_cstring(&path);
+            // The list's copy is made before the file exists, for the same reason.
+            let listed = registered.clone();
             match fs::OpenOptions::new().write(true).create_new(true).open(&path) {
                 Ok(file) => {
-                    if let Some(c) = &registered {
-                        list.push(c.clone());
+                    if let Some(c) = listed {
+                        list.push(c); // into the room reserved above: no allocation
                     }
                     return Ok(TemporaryFile {
                         path,
