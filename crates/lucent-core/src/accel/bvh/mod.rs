@@ -432,27 +432,30 @@ mod tests {
     }
 
     /// A tree no build makes, to hold the traversal stacks to their bound: a chain of
-    /// `levels` nodes of `W` children whose boxes are all one cube, each node's first
-    /// child the next node and the others leaves (the last node's children all leaves),
-    /// every leaf the one packet. A ray through the cube enters every child of every node
-    /// and, the children being equally near, goes down the chain first (a node's
-    /// reference orders before a leaf's), leaving `W - 1` entries behind at each level
-    /// and pushing `W` more at the last: the most any tree of that many levels can ask of
-    /// the stack.
+    /// `levels` nodes of `W` children, each node's first child the next node and the
+    /// others leaves (the last node's children all leaves), every leaf the one packet,
+    /// every leaf's box one cube and every node's a slightly larger one around it. A ray
+    /// through the cube enters every child of every node and goes down the chain first
+    /// (its box is nearer), single rays and packets alike, leaving `W - 1` entries behind
+    /// at each level and pushing `W` more at the last: the most any tree of that many
+    /// levels can ask of the stacks.
     fn chain<const W: usize>(levels: usize) -> Vec<WideNode<W>> {
         let size = std::mem::size_of::<WideNode<W>>() as u32;
         (0..levels)
             .map(|level| {
                 let mut node = WideNode::<W>::EMPTY;
                 for slot in 0..W {
+                    let inner = slot == 0 && level + 1 < levels;
+                    let half = if inner { 1.1 } else { 1.0 };
                     for axis in 0..3 {
-                        node.bounds[axis][slot] = -1.0;
-                        node.bounds[axis + 3][slot] = 1.0;
+                        node.bounds[axis][slot] = -half;
+                        node.bounds[axis + 3][slot] = half;
                     }
-                    node.child[slot] = wide::LEAF; // packet 0, one packet
-                }
-                if level + 1 < levels {
-                    node.child[0] = (level as u32 + 1) * size;
+                    node.child[slot] = if inner {
+                        (level as u32 + 1) * size
+                    } else {
+                        wide::LEAF // packet 0, one packet
+                    };
                 }
                 node
             })

@@ -12,6 +12,7 @@ use super::wide::WideNode;
 #[cfg(doc)]
 use crate::ray::PreparedRay;
 use crate::ray::Ray;
+use std::mem::offset_of;
 
 /// The rays' box-test constants, one lane each: the fused test of [`FmaOffsets`] (whose
 /// bound holds lane by lane), a plane `b` giving the near distance `b · inv − near_off`
@@ -45,22 +46,20 @@ pub(super) struct PacketLanes<L> {
 #[inline(always)]
 pub(super) unsafe fn packet_lanes<L: RayLanes>(rays: &[Ray]) -> PacketLanes<L> {
     debug_assert!(!rays.is_empty() && rays.len() <= L::N);
-    let (stride, last) = (std::mem::size_of::<Ray>() / 4, rays.len() - 1);
-    let origin = (&rays[0].origin as *const crate::math::Vec3A).cast::<f32>();
-    let dir = (&rays[0].dir as *const crate::math::Vec3A).cast::<f32>();
     let (zero, inf) = (L::splat(0.0), L::splat(f32::INFINITY));
-    let t_min = L::gather(&rays[0].t_min, stride, last);
+    let t_min = L::gather_field(rays, offset_of!(Ray, t_min));
     // A NaN far limit would make the packet's largest search limit NaN, and its interval
     // test drop every child for all the packet's rays; rays with an empty interval find
     // nothing anyway. Both are traced alone.
-    let t_max = L::gather(&rays[0].t_max, stride, last);
+    let t_max = L::gather_field(rays, offset_of!(Ray, t_max));
     let mut ok = L::ALL >> (L::N - rays.len()) & zero.le(t_min) & t_min.le(t_max);
     let (mut o, mut d, mut inv) = ([zero; 3], [zero; 3], [zero; 3]);
     let (mut near_off, mut far_off, mut inv_far) = ([zero; 3], [zero; 3], [zero; 3]);
     let mut negative = [0u32; 3];
     for a in 0..3 {
-        o[a] = L::gather(origin.add(a), stride, last);
-        d[a] = L::gather(dir.add(a), stride, last);
+        // (A vector's components lie 4 bytes apart, x first.)
+        o[a] = L::gather_field(rays, offset_of!(Ray, origin) + 4 * a);
+        d[a] = L::gather_field(rays, offset_of!(Ray, dir) + 4 * a);
         inv[a] = L::splat(1.0).div(d[a]);
         let p = o[a].mul(inv[a]);
         let c = p.abs().mul(L::splat(FmaOffsets::OFFSET));

@@ -11,6 +11,8 @@
 //! functions compiled for their instruction set (not inside a closure there, which is a
 //! function of its own).
 
+use crate::ray::Ray;
+
 /// A vector of one `f32` per ray.
 pub trait RayLanes: Copy {
     const N: usize;
@@ -23,6 +25,16 @@ pub trait RayLanes: Copy {
     unsafe fn store(self, p: *mut f32);
     /// Lane `i` is `*base.add(stride · min(i, last))`: one field of consecutive records.
     unsafe fn gather(base: *const f32, stride: usize, last: usize) -> Self;
+    /// Lane `i` is the `f32` at byte `field` of `rays[min(i, len − 1)]` (a field's
+    /// `offset_of!` in [`Ray`]). The gather's base pointer is made from the whole slice,
+    /// so that it may reach every ray: one made from a reference to the first ray's field
+    /// would reach that field alone.
+    #[inline(always)]
+    unsafe fn gather_field(rays: &[Ray], field: usize) -> Self {
+        debug_assert!(!rays.is_empty() && field + 4 <= std::mem::size_of::<Ray>());
+        let base = rays.as_ptr().cast::<u8>().add(field).cast::<f32>();
+        Self::gather(base, std::mem::size_of::<Ray>() / 4, rays.len() - 1)
+    }
     /// `|self|`.
     unsafe fn abs(self) -> Self;
     unsafe fn add(self, o: Self) -> Self;

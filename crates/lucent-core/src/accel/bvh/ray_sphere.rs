@@ -13,6 +13,7 @@
 use super::ray_lanes::RayLanes;
 use crate::math::Affine3A;
 use crate::ray::Ray;
+use std::mem::offset_of;
 
 /// What the sphere test needs of a packet's rays, one lane per ray.
 pub struct SphereRays<L> {
@@ -29,21 +30,20 @@ impl<L: RayLanes> SphereRays<L> {
     #[inline(always)]
     pub unsafe fn gather(rays: &[Ray]) -> SphereRays<L> {
         debug_assert!(!rays.is_empty() && rays.len() <= L::N);
-        let stride = std::mem::size_of::<Ray>() / 4;
-        let last = rays.len() - 1;
-        let r = &rays[0];
+        // (A vector's components lie 4 bytes apart, x first. No closure: see `roots`.)
+        let (origin, dir) = (offset_of!(Ray, origin), offset_of!(Ray, dir));
         SphereRays {
             origin: [
-                L::gather(&r.origin.x, stride, last),
-                L::gather(&r.origin.y, stride, last),
-                L::gather(&r.origin.z, stride, last),
+                L::gather_field(rays, origin),
+                L::gather_field(rays, origin + 4),
+                L::gather_field(rays, origin + 8),
             ],
             dir: [
-                L::gather(&r.dir.x, stride, last),
-                L::gather(&r.dir.y, stride, last),
-                L::gather(&r.dir.z, stride, last),
+                L::gather_field(rays, dir),
+                L::gather_field(rays, dir + 4),
+                L::gather_field(rays, dir + 8),
             ],
-            t_min: L::gather(&r.t_min, stride, last),
+            t_min: L::gather_field(rays, offset_of!(Ray, t_min)),
         }
     }
 

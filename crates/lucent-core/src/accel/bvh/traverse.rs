@@ -63,6 +63,9 @@ pub const fn levels_held(stack: usize, width: usize) -> usize {
 /// Asks for the first cache lines of a child that was pushed on the stack: by the time
 /// it is popped, after the nearer subtree, they have arrived (single rays and packets).
 /// Four lines, of a node's seven: asking for all seven measured no better.
+///
+/// # Safety
+/// `reference` is a child of the tree `nodes`, `packets`: a node's byte offset or a leaf.
 #[inline(always)]
 pub(super) unsafe fn prefetch<const W: usize>(nodes: &[WideNode<W>], packets: &[Packet], reference: u32) {
     #[cfg(target_arch = "x86_64")]
@@ -73,8 +76,10 @@ pub(super) unsafe fn prefetch<const W: usize>(nodes: &[WideNode<W>], packets: &[
         } else {
             packets.as_ptr().add(leaf_packets(reference).start).cast::<i8>()
         };
+        // (`wrapping_add`: a leaf's last packet ends before the fourth line; a prefetch
+        // of any address is harmless, but `add` may not leave the allocation.)
         for line in 0..4 {
-            _mm_prefetch::<_MM_HINT_T0>(p.add(64 * line));
+            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * line));
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
