@@ -4,7 +4,9 @@
 //! per unit of length along every axis (λ = 3): about `λ·N` cells in all, so about
 //! `λ^(1/3)·N^(1/3)` per axis, more along the box's long sides. Each primitive is entered into every
 //! cell it overlaps — its bounding box picks the candidates, the exact triangle–box test
-//! decides — in one flat array with an offset per cell.
+//! decides — in one flat array with an offset per cell. When the primitives' boxes
+//! would put more than 64 entries a primitive into the cells (primitives that overlap,
+//! at worst all at one place), the cells are made larger until they do not.
 //!
 //! Traversal: 3-D DDA (Amanatides & Woo 1987) from the cell where the ray enters, always
 //! stepping across the nearest cell wall, so cells are visited in ray order; the search
@@ -21,6 +23,8 @@ use crate::ray::PreparedRay;
 /// Cells per primitive.
 const DENSITY: f32 = 3.0;
 const MAX_RES: usize = 512;
+/// The most cell entries a primitive may make on average (see [`Grid::build`]).
+const MAX_ENTRIES_PER_PRIM: usize = 64;
 
 pub struct Grid {
     bounds: Aabb,
@@ -53,17 +57,36 @@ impl Grid {
         // In f64: in f32 the volume of a scene under about 1e-13 across is subnormal, and
         // under 1e-15 zero, which made every axis MAX_RES cells (512³ for one primitive).
         let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3)).as_dvec3();
-        let per_unit = (DENSITY as f64 * items.len() as f64 / (e.x * e.y * e.z)).cbrt();
-        let res = [0, 1, 2].map(|a| ((ext[a] as f64 * per_unit).round() as usize).clamp(1, MAX_RES));
-        let cell_size = ext / Vec3A::new(res[0] as f32, res[1] as f32, res[2] as f32);
-        let mut grid = Grid {
-            bounds,
-            res,
-            cell_size,
-            cell_start: Vec::new(),
-            prim_ids: Vec::new(),
-            prim_count: prims.count(),
+        let mut per_unit = (DENSITY as f64 * items.len() as f64 / (e.x * e.y * e.z)).cbrt();
+        // Primitives that overlap (at worst all at one place) each span many cells: N of
+        // them in N cells would make N² entries (12,000 spheres at one point, 1.7 GB). The
+        // cells are halved along every axis until their candidates fit the bound.
+        let bound = (MAX_ENTRIES_PER_PRIM * items.len()).clamp(1 << 12, u32::MAX as usize / 2);
+        let mut grid = loop {
+            let res = [0, 1, 2].map(|a| ((ext[a] as f64 * per_unit).round() as usize).clamp(1, MAX_RES));
+            let grid = Grid {
+                bounds,
+                res,
+                cell_size: ext / Vec3A::new(res[0] as f32, res[1] as f32, res[2] as f32),
+                cell_start: Vec::new(),
+                prim_ids: Vec::new(),
+                prim_count: prims.count(),
+            };
+            let candidates = items
+                .iter()
+                .map(|(_, b)| {
+                    let b = padded(b, pad);
+                    (0..3)
+                        .map(|a| grid.cell_of(b.max, a) - grid.cell_of(b.min, a) + 1)
+                        .product::<usize>()
+                })
+                .fold(0usize, usize::saturating_add);
+            if candidates <= bound || res == [1; 3] {
+                break grid;
+            }
+            per_unit /= 2.0;
         };
+        let res = grid.res;
         // Two passes: count the entries of every cell, then fill them in.
         let cells = res[0] * res[1] * res[2];
         let mut count = vec![0u32; cells + 1];
@@ -207,6 +230,23 @@ mod tests {
             let tri = [Vec3A::ZERO, Vec3A::new(size, 0.0, 0.0), Vec3A::new(0.0, size, size)];
             let grid = Grid::build(&Triangles(vec![tri; 2]));
             assert!(grid.res.iter().product::<usize>() <= 8, "{size}: {:?}", grid.res);
+        }
+    }
+
+    #[test]
+    fn primitives_at_one_place_make_a_bounded_grid() {
+        use crate::accel::{AccelKind, Accelerator};
+        use crate::ray::Ray;
+        // 3,000 copies of one triangle: a grid sized for 3,000 primitives made every copy
+        // an entry of every cell the triangle crosses, 65,829,000 entries in all.
+        let prims = Triangles(vec![[Vec3A::ZERO, Vec3A::X, Vec3A::Y]; 3000]);
+        let grid = Grid::build(&prims);
+        assert!(grid.prim_ids.len() <= 64 * 3000, "{} entries", grid.prim_ids.len());
+        let list = AccelKind::List.build(&prims);
+        for k in 0..100 {
+            let o = Vec3A::new(k as f32 / 80.0 - 0.1, 0.3, 1.0);
+            let r = PreparedRay::new(Ray::new(o, (Vec3A::new(0.25, 0.25, 0.0) - o).normalize()));
+            assert_eq!(grid.closest_hit(&prims, &r), list.closest_hit(&prims, &r), "ray {k}");
         }
     }
 }
