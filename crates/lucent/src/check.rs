@@ -41,7 +41,7 @@ pub fn run(args: &CheckArgs) -> u8 {
         let mut text = Vec::new();
         let read = std::io::Read::read_to_end(&mut std::io::Read::take(std::io::stdin(), 1 << 30), &mut text);
         if let Err(e) = read {
-            eprintln!("lucent: error: cannot read the scene from standard input: {e}");
+            errln!("lucent: error: cannot read the scene from standard input: {e}");
             return EXIT_BAD_INPUT;
         }
         let mut s = Session::parse_text("-", &text, options);
@@ -83,15 +83,15 @@ pub fn run(args: &CheckArgs) -> u8 {
     let c = desc.camera.as_ref().expect("checked by the parser").value;
     let v = |v: lucent_core::math::DVec3| format!("({}, {}, {})", v.x, v.y, v.z);
 
-    println!("scene:      {}", args.scene.display());
-    println!("size:       {w} x {h}");
-    println!(
+    outln!("scene:      {}", args.scene.display());
+    outln!("size:       {w} x {h}");
+    outln!(
         "output:     {}",
         desc.output
             .as_ref()
             .map_or("raytrace.png (default)", |o| o.value.as_str())
     );
-    println!(
+    outln!(
         "camera:     eye {} look-at {} up {} {}",
         v(c.eye),
         v(c.center),
@@ -101,7 +101,7 @@ pub fn run(args: &CheckArgs) -> u8 {
             ProjectionDesc::Orthographic { height } => format!("orthographic, height {height}"),
         }
     );
-    println!(
+    outln!(
         "integrator: {}, maxdepth {}",
         desc.integrator().name(),
         desc.max_depth()
@@ -123,16 +123,16 @@ pub fn run(args: &CheckArgs) -> u8 {
     .filter(|&(_, n)| n > 0)
     .map(|(name, n)| format!(", {n} {name}{}", if n == 1 { "" } else { "s" }))
     .collect();
-    println!(
+    outln!(
         "objects:    {spheres} spheres, {} triangles ({trinormals} with vertex normals){}",
         tris + trinormals,
         others.concat()
     );
-    println!(
+    outln!(
         "primitives: {} after build",
         built.scene.geometry.shown_primitive_count()
     );
-    println!(
+    outln!(
         "lights:     {} point, {} directional, {} quad",
         lights(&|k| matches!(k, LightKind::Point { .. })),
         lights(&|k| matches!(k, LightKind::Directional { .. })),
@@ -141,29 +141,32 @@ pub fn run(args: &CheckArgs) -> u8 {
     // The scene's materials and its meshes' MTL materials; not the one the build adds for
     // the surfaces of quad lights.
     let quad_lights = lights(&|k| matches!(k, LightKind::Quad { .. }));
-    println!("materials:  {}", built.scene.materials.len() - quad_lights.min(1));
+    outln!("materials:  {}", built.scene.materials.len() - quad_lights.min(1));
     let spp = desc.spp.as_ref().map_or(1, |s| s.value);
     let samples = desc.light_samples.as_ref().map_or(1, |s| s.value);
     let stratified = desc.light_stratify.as_ref().is_some_and(|s| s.value);
     let lens = desc.lens.as_ref().map_or(String::new(), |l| {
         format!(", lens aperture {} focus {}", l.value.0, l.value.1)
     });
-    println!(
+    outln!(
         "sampling:   spp {spp}, lightsamples {samples}{}{lens}",
         if stratified { " (stratified)" } else { "" }
     );
     let w = &built.work;
-    println!(
+    outln!(
         "work:       about {:.1e} rays ({:.0} per pixel, at most {:.0}), reflections up to depth {}",
-        w.rays, w.rays_per_pixel, w.most_rays_per_pixel, w.depth
+        w.rays,
+        w.rays_per_pixel,
+        w.most_rays_per_pixel,
+        w.depth
     );
-    println!(
+    outln!(
         "memory:     about {} for the scene, {} for the picture (of {})",
         bytes(scene_memory),
         bytes(picture_memory),
         bytes(session.res.budget.limit())
     );
-    println!(
+    outln!(
         "textures:   {}{}",
         desc.textures.len(),
         if desc.environment.is_some() {

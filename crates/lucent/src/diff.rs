@@ -52,20 +52,27 @@ pub fn run(args: &DiffArgs) -> u8 {
     let (a, b) = match (read(&args.a), read(&args.b)) {
         (Ok(a), Ok(b)) => (a, b),
         (Err(e), _) | (_, Err(e)) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
     let Some(d) = diff(&a, &b, args.threshold) else {
-        eprintln!(
+        errln!(
             "lucent: error: the images differ in size: {}x{} and {}x{}",
-            a.width, a.height, b.width, b.height
+            a.width,
+            a.height,
+            b.width,
+            b.height
         );
         return EXIT_BAD_INPUT;
     };
-    println!(
+    outln!(
         "pixels_over={} pixels={} threshold={} mae={:.4} max={}",
-        d.pixels_over, d.pixels, args.threshold, d.mean_abs_error, d.max_abs_error
+        d.pixels_over,
+        d.pixels,
+        args.threshold,
+        d.mean_abs_error,
+        d.max_abs_error
     );
     let too_many = args.max_pixels.is_some_and(|m| d.pixels_over > m);
     let too_far = args.max_mae.is_some_and(|m| d.mean_abs_error >= m);
@@ -81,19 +88,22 @@ fn run_noise(args: &DiffArgs) -> u8 {
     let (a, b) = match (read(&args.a), read(&args.b)) {
         (Ok(a), Ok(b)) => (a, b),
         (Err(e), _) | (_, Err(e)) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
     let Some(g) = agreement(&a, &b, 8, 6) else {
-        eprintln!(
+        errln!(
             "lucent: error: the images differ in size or are too small: {}x{} and {}x{}",
-            a.width, a.height, b.width, b.height
+            a.width,
+            a.height,
+            b.width,
+            b.height
         );
         return EXIT_BAD_INPUT;
     };
     let (x, y, c) = g.worst_at;
-    println!(
+    outln!(
         "mean_ratio={:.4} whole_z={:+.2} worst_region_z={:+.2} at col {x} row {y} channel {}",
         g.mean_ratio,
         g.whole_z,

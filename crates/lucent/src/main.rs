@@ -2,6 +2,10 @@
 //! and says what it holds, `diff` compares two images, `merge` puts render states
 //! together, `plan` cuts a render into tasks, `bench` measures speed.
 
+// First: its macros are for every module below.
+#[macro_use]
+mod console;
+
 mod aov_args;
 mod bench;
 mod check;

@@ -51,7 +51,7 @@ pub fn run(args: &MergeArgs) -> u8 {
     let denoiser = match args.denoise.then(lucent_io::denoise::Denoiser::load).transpose() {
         Ok(d) => d,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -71,7 +71,7 @@ pub fn run(args: &MergeArgs) -> u8 {
         match read_state(path, &mut budget, &mut inputs) {
             Ok(s) => states.push(s),
             Err(e) => {
-                eprintln!("lucent: error: {name}: {e}");
+                errln!("lucent: error: {name}: {e}");
                 return EXIT_BAD_INPUT;
             }
         }
@@ -82,13 +82,13 @@ pub fn run(args: &MergeArgs) -> u8 {
     let aovs = states[0].header.aovs;
     let picture = states.iter().map(|s| s.film_bytes()).sum::<u64>() + image_bytes(pixels, aovs, &extras);
     if let Err(e) = budget.take(picture, "the merged picture") {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     let merged = match merge(&states, &names) {
         Ok(m) => m,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -97,18 +97,18 @@ pub fn run(args: &MergeArgs) -> u8 {
     let out = match choose_output(Some(&args.output), &SceneDesc::default(), &mut diags) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
     if extras.need_aovs() && !merged.header.aovs {
-        eprintln!("lucent: error: --aov and --denoise need the auxiliary passes, and these states keep none: render them with --aov or --denoise");
+        errln!("lucent: error: --aov and --denoise need the auxiliary passes, and these states keep none: render them with --aov or --denoise");
         return EXIT_BAD_INPUT;
     }
     let aov_side = match aov_file(&out, extras.aovs) {
         Ok(a) => a,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -116,7 +116,7 @@ pub fn run(args: &MergeArgs) -> u8 {
         Ok(t) => t,
         Err(e) => {
             let name = args.state.as_ref().map_or(String::new(), |p| p.display().to_string());
-            eprintln!("lucent: error: cannot write {name}: {e}");
+            errln!("lucent: error: cannot write {name}: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -126,7 +126,7 @@ pub fn run(args: &MergeArgs) -> u8 {
     targets.extend(aov_side.iter().map(|a| (a.name.as_path(), &a.target)));
     targets.extend(args.state.iter().map(|p| p.as_path()).zip(&state_out));
     if let Err(e) = check_targets(&targets, &inputs) {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     // Every output or none.
@@ -141,7 +141,7 @@ pub fn run(args: &MergeArgs) -> u8 {
         write_all(&files)
     });
     if let Err(e) = written {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     0

@@ -102,7 +102,7 @@ pub fn report(diags: &Diagnostics, sources: &SourceMap, notes: bool) {
     }
     let text = shown.render(sources);
     if !text.is_empty() {
-        eprint!("{text}");
+        err!("{text}");
     }
 }
 

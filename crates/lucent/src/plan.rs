@@ -102,8 +102,8 @@ pub fn apply(
         // `--json -`: standard output holds the JSON alone (a program reads it), the
         // table goes to standard error.
         match target {
-            Some(OutputTarget::Stdout) => eprint!("{}", describe(scene, job, &plan)),
-            _ => print!("{}", describe(scene, job, &plan)),
+            Some(OutputTarget::Stdout) => err!("{}", describe(scene, job, &plan)),
+            _ => out!("{}", describe(scene, job, &plan)),
         }
         if let (Some(path), Some(t)) = (&request.json, target) {
             t.write(json(scene, job, &plan).as_bytes())

@@ -30,7 +30,7 @@ pub struct PlanArgs {
 
 pub fn run(args: &PlanArgs) -> u8 {
     if args.render.scenes.len() != 1 {
-        eprintln!("lucent: error: plan one scene at a time");
+        errln!("lucent: error: plan one scene at a time");
         return EXIT_BAD_INPUT;
     }
     let request = PlanRequest {

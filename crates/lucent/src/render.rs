@@ -49,11 +49,11 @@ pub fn run(args: &RenderArgs) -> u8 {
             (args.spp_map.is_some(), "--spp-map"),
         ];
         if let Some((_, flag)) = single.iter().find(|(given, _)| *given) {
-            eprintln!("lucent: error: {flag} names one file, and {} scenes were given: render them one at a time, or let each scene's output command (else SCENE.png beside it) name its image", args.scenes.len());
+            errln!("lucent: error: {flag} names one file, and {} scenes were given: render them one at a time, or let each scene's output command (else SCENE.png beside it) name its image", args.scenes.len());
             return EXIT_BAD_INPUT;
         }
         if args.scenes.iter().filter(|s| s.as_os_str() == "-").count() > 1 {
-            eprintln!("lucent: error: standard input (-) can hold one scene");
+            errln!("lucent: error: standard input (-) can hold one scene");
             return EXIT_BAD_INPUT;
         }
     }
@@ -92,7 +92,7 @@ pub fn run_one(
         let mut text = Vec::new();
         let read = std::io::Read::read_to_end(&mut std::io::Read::take(std::io::stdin(), 1 << 30), &mut text);
         if let Err(e) = read {
-            eprintln!("lucent: error: cannot read the scene from standard input: {e}");
+            errln!("lucent: error: cannot read the scene from standard input: {e}");
             return EXIT_BAD_INPUT;
         }
         Session::parse_text_with("-", &text, options, &lines)
@@ -125,7 +125,7 @@ pub fn run_one(
         Ok(out) => out,
         Err(msg) => {
             report(&session.diags, &session.desc.sources, false);
-            eprintln!("lucent: error: {msg}");
+            errln!("lucent: error: {msg}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -134,7 +134,7 @@ pub fn run_one(
             Ok(m) => Some(m),
             Err(msg) => {
                 report(&session.diags, &session.desc.sources, false);
-                eprintln!("lucent: error: --spp-map: {msg}");
+                errln!("lucent: error: --spp-map: {msg}");
                 return EXIT_BAD_INPUT;
             }
         },
@@ -144,7 +144,7 @@ pub fn run_one(
         Some(p) => match OutputTarget::resolve(p) {
             Ok(t) => Some((p.clone(), t)),
             Err(e) => {
-                eprintln!("lucent: error: --state: cannot write {}: {e}", p.display());
+                errln!("lucent: error: --state: cannot write {}: {e}", p.display());
                 return EXIT_BAD_INPUT;
             }
         },
@@ -153,7 +153,7 @@ pub fn run_one(
     let aov_side = match aov_file(&out, args.aov.unwrap_or_default()) {
         Ok(side) => side,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -161,7 +161,7 @@ pub fn run_one(
     let denoiser = match args.denoise.then(lucent_io::denoise::Denoiser::load).transpose() {
         Ok(d) => d,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -183,7 +183,7 @@ pub fn run_one(
         Some(p) => match OutputTarget::resolve(p) {
             Ok(t) => Some((p.clone(), t)),
             Err(e) => {
-                eprintln!("lucent: error: --json: cannot write {}: {e}", p.display());
+                errln!("lucent: error: --json: cannot write {}: {e}", p.display());
                 return EXIT_BAD_INPUT;
             }
         },
@@ -213,7 +213,7 @@ pub fn run_one(
     checked = checked.and_then(|()| earlier.check(&every));
     if let Err(e) = checked {
         report(&session.diags, &session.desc.sources, false);
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     let renderer = match start_renderer(args.threads) {
@@ -232,7 +232,7 @@ pub fn run_one(
     named.extend(&session.res.inputs);
     let checked = check_targets(&partials, &session.res.inputs).and_then(|()| check_targets(&final_targets, &named));
     if let Err(e) = checked {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     // From here on the scene may write: the later scenes of the run must leave its inputs
@@ -306,7 +306,7 @@ pub fn run_one(
         Ok(Planned::Render) => {}
         Ok(Planned::Printed) => return 0,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     }
@@ -325,7 +325,7 @@ pub fn run_one(
             Ok(())
         });
     if let Err(e) = part {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     let now = header(&job);
@@ -333,7 +333,7 @@ pub fn run_one(
         Some(path) => match resume(path, &mut job, &now, &mut session.res.budget) {
             Ok(s) => Some(s),
             Err(e) => {
-                eprintln!("lucent: error: --resume {}: {e}", path.display());
+                errln!("lucent: error: --resume {}: {e}", path.display());
                 return EXIT_BAD_INPUT;
             }
         },
@@ -371,7 +371,7 @@ pub fn run_one(
         signals::saving(true);
         match partial.write(film, kept, &extras) {
             Ok(()) => wrote_partial = true,
-            Err(e) => eprintln!("lucent: warning: checkpoint not written: {e}"),
+            Err(e) => errln!("lucent: warning: checkpoint not written: {e}"),
         }
         if !cancel.load(Ordering::Relaxed) {
             signals::saving(false);
@@ -416,19 +416,19 @@ pub fn run_one(
                 )
             };
             match partial.write(&film, kept, &extras) {
-                Ok(()) => eprintln!(
+                Ok(()) => errln!(
                     "lucent: interrupted after samples {}..{} of every pixel: wrote {} and {}; {how}",
                     samples.start,
                     samples.end - 1,
                     partial.image_name(),
                     partial.state_name()
                 ),
-                Err(e) => eprintln!("lucent: interrupted; the partial render was not written: {e}"),
+                Err(e) => errln!("lucent: interrupted; the partial render was not written: {e}"),
             }
             return signals::exit_code();
         }
         _ => {
-            eprintln!("lucent: interrupted; nothing written");
+            errln!("lucent: interrupted; nothing written");
             return signals::exit_code();
         }
     };
@@ -449,7 +449,7 @@ pub fn run_one(
         } else {
             ""
         };
-        eprintln!(
+        errln!(
             "lucent: warning: {} samples were NaN or infinite and were replaced by black, first at pixels {}{more}",
             stats.bad_samples,
             at.join(", ")
@@ -457,14 +457,14 @@ pub fn run_one(
     }
     if stats.cut_branches > 0 {
         extra_warnings += 1;
-        eprintln!(
+        errln!(
             "lucent: warning: {} ray branches were not traced: a camera sample's ray tree passed {MAX_TREE_RAYS} rays, or more than {MAX_PENDING} branches were waiting at once (glass, and mirrors that reflect everything, with a large maxdepth)",
             stats.cut_branches,
         );
     }
     // Once more before writing (the inputs are the same; a file may have been linked).
     if let Err(e) = check_targets(&final_targets, &named) {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     let writing = Progress::phase("writing", args.quiet);
@@ -475,7 +475,7 @@ pub fn run_one(
     let mut files = match encode_picture(&out, &film, &kept, &extras) {
         Ok(f) => f,
         Err(e) => {
-            eprintln!("lucent: error: {e}");
+            errln!("lucent: error: {e}");
             return EXIT_BAD_INPUT;
         }
     };
@@ -498,7 +498,7 @@ pub fn run_one(
         match encode_image(map, &counts, &linear) {
             Ok(f) => files.push(f),
             Err(e) => {
-                eprintln!("lucent: error: {e}");
+                errln!("lucent: error: {e}");
                 return EXIT_BAD_INPUT;
             }
         }
@@ -521,7 +521,7 @@ pub fn run_one(
     // (The next scene of the run renders, and is interrupted, as this one was.)
     signals::writing_final(false);
     if let Err(e) = written {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         return EXIT_BAD_INPUT;
     }
     if wrote_partial {
@@ -533,7 +533,7 @@ pub fn run_one(
     let scene = &built.scene;
     let render_s = (t_rendered - t_render).as_secs_f64();
     if !args.quiet {
-        eprintln!(
+        errln!(
             "{}x{}, {} primitives, {} rays, {:.3} s, {:.2} Mrays/s -> {}",
             film.width,
             film.height,
@@ -547,12 +547,12 @@ pub fn run_one(
     let warnings = session.diags.count(lucent_io::diag::Severity::Warning) + extra_warnings;
     if warnings > 0 && !args.quiet {
         let s = if warnings == 1 { "" } else { "s" };
-        eprintln!("lucent: {warnings} warning{s} (see above)");
+        errln!("lucent: {warnings} warning{s} (see above)");
     }
     if job.noise_threshold.is_some() && !args.quiet {
         // From the film: with --resume it holds the earlier samples too.
         let counts = &film.counts;
-        eprintln!(
+        errln!(
             "adaptive sampling: {:.1} samples per pixel on average (min {}, max {}, cap {})",
             counts.iter().map(|&n| n as f64).sum::<f64>() / counts.len().max(1) as f64,
             counts.iter().min().copied().unwrap_or(0),
@@ -561,7 +561,7 @@ pub fn run_one(
         );
     }
     if args.stats {
-        eprintln!(
+        errln!(
             "parse {:.3} s, build {:.3} s ({} {:.1} MB), render {:.3} s on {} threads ({:.3} Msamples/s, {:.2} rays per sample), write {:.3} s, total {:.3} s",
             session.parse_seconds,
             session.build_seconds,
@@ -582,7 +582,7 @@ pub fn run_one(
 /// saying why they could not start.
 pub fn start_renderer(threads: Option<u32>) -> Result<Renderer, u8> {
     Renderer::new(threads.map(|n| n as usize)).map_err(|e| {
-        eprintln!("lucent: error: {e}");
+        errln!("lucent: error: {e}");
         EXIT_BAD_INPUT
     })
 }

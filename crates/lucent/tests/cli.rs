@@ -593,3 +593,41 @@ fn several_scenes_in_one_run_and_a_scene_on_standard_input() {
     assert!(o.status.success());
     assert!(String::from_utf8_lossy(&o.stdout).contains("scene:      -"));
 }
+
+#[test]
+fn closed_output_streams_lose_the_text_not_the_run() {
+    // A pipe whose reader is gone (`lucent check … | head -1` once head has quit):
+    // writing to it fails at once, which `println!` would turn into a panic.
+    let closed = || {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        writer
+    };
+    let dir = workdir("closed_streams");
+    fs::write(dir.join("a.test"), SCENE).unwrap();
+    let run = |args: &[&str], stdout_closed: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_lucent"));
+        c.args(args).current_dir(&*dir);
+        if stdout_closed {
+            c.stdout(closed()).stderr(std::process::Stdio::piped());
+        } else {
+            c.stdout(std::process::Stdio::piped()).stderr(closed());
+        }
+        c.output().expect("run lucent")
+    };
+    for (args, stdout_closed) in [
+        (&["check", "a.test"][..], true),
+        (&["check", "a.test"][..], false),
+        (&["check", "missing.test"][..], false),
+        (&["render", "a.test", "-o", "a.png"][..], false),
+        (&["render", "a.test", "-o", "b.png", "--stats"][..], true),
+        (&["diff", "a.png", "b.png"][..], true),
+    ] {
+        let o = run(args, stdout_closed);
+        let code = o.status.code();
+        let expected = if args[1] == "missing.test" { Some(2) } else { Some(0) };
+        assert_eq!(code, expected, "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).contains("panicked"), "{args:?}: {}", stderr(&o));
+    }
+    assert!(dir.join("a.png").exists() && dir.join("b.png").exists());
+}

@@ -59,6 +59,7 @@ const IO: Floors = &[
 ];
 
 const CLI: Floors = &[
+    ("console", 0),
     ("output", 0),
     ("progress", 0),
     ("signals", 0),

@@ -185,7 +185,7 @@ pub fn run(args: &RaysBenchArgs) -> u8 {
     match bench(args) {
         Ok(()) => 0,
         Err(msg) => {
-            eprintln!("error: {msg}");
+            errln!("error: {msg}");
             EXIT_BAD_INPUT
         }
     }
@@ -298,7 +298,7 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
             .write(&bytes)
             .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
     }
-    println!(
+    outln!(
         "mrays_per_s={:.4} build_s={build_s:.4} bytes_per_tri={:.1} rays={} hits={hits} accel={}{} isa={isa:?} threads={} build_threads={} tris={} trace_s={trace_s:.4}",
         rays.len() as f64 / trace_s / 1e6,
         accel.memory_bytes() as f64 / mesh.mesh.indices.len().max(1) as f64,

@@ -60,7 +60,7 @@ pub fn run(args: &SceneBenchArgs) -> u8 {
         .scene
         .file_stem()
         .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-    println!(
+    outln!(
         "scene={name} accel={} threads={} parse_s={parse_s:.4} build_s={build_s:.4} render_s={median:.4} rays={rays} mrays_per_s={:.2} reps={}",
         accel.name(),
         renderer.threads(),
