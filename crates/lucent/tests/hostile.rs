@@ -905,6 +905,26 @@ fn textures_and_tessellations_are_held_to_the_budget_before_they_are_made() {
     assert!(!r.stderr.contains(":7:1: error"), "the first five fit: {}", r.stderr);
 }
 
+#[test]
+fn many_short_shapes_are_held_to_what_they_take() {
+    // 600,000 spheres of 15 bytes of text each (a file of 60,000 included ten times):
+    // a render takes about 400 MB at its peak (measured 662 bytes a sphere in all), so a
+    // budget of 300 MB must refuse them (it let them through when a shape was priced at
+    // 256 bytes and its text at 8 bytes a byte: 226 MB).
+    let dir = workdir("short_shapes");
+    let lines: String = (0..60_000).map(|_| "sphere 0 0 0 1\n").collect();
+    fs::write(dir.join("s.inc"), lines).unwrap();
+    let includes: String = (0..10).map(|_| "include s.inc\n").collect();
+    fs::write(
+        dir.join("many.test"),
+        format!("size 8 8\ncamera 0 0 5 0 0 0 0 1 0 45\n{includes}"),
+    )
+    .unwrap();
+    let r = run(&dir, &["check", "many.test", "--memory-limit", "300M"], seconds(60));
+    assert_eq!(r.code, Some(2), "{}", r.stderr);
+    says(&r, "600000 shapes needs about");
+}
+
 /// A flat (uncompressed) Radiance HDR file of `width × height` texels of one colour.
 fn flat_hdr(width: u32, height: u32) -> Vec<u8> {
     let mut out = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n").into_bytes();
