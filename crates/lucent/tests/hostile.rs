@@ -240,6 +240,25 @@ fn absurd_work_is_estimated_and_warned_about() {
     );
     assert_eq!(r.code, Some(0), "{}", r.stderr);
     assert!(!r.stderr.contains("this render traces"), "{}", r.stderr);
+    // Two facing mirrors a million bounces deep, and thin boxes on the rows of an 8 × 8
+    // grid's cell centres, where the probe's pixels were: it saw only the boxes (one ray
+    // a pixel), and the render took hours without a word.
+    let boxes: String = (0..8)
+        .map(|j| {
+            let y = 0.4142 * (1.0 - (2 * j + 1) as f64 / 8.0);
+            format!("box -10 {:.4} 3.9 10 {:.4} 4\n", y - 0.0024, y + 0.0024)
+        })
+        .collect();
+    fs::write(
+        dir.join("hidden.test"),
+        format!(
+            "size 256 256\ncamera 0 0 5 0 0 0 0 1 0 45\nmaxdepth 1000000\npoint 0 0 0 1 1 1\nspecular 1 1 1\n\
+             plane 0 1 0 0 1 0\nplane 0 -1 0 0 1 0\nspecular 0 0 0\n{boxes}"
+        ),
+    )
+    .unwrap();
+    let r = run(&dir, &["check", "hidden.test"], seconds(30));
+    says(&r, "hidden.test:3:1: warning: maxdepth: this render traces about");
 }
 
 #[test]
