@@ -75,10 +75,8 @@ impl Grid {
             let candidates = items
                 .iter()
                 .map(|(_, b)| {
-                    let b = padded(b, pad);
-                    (0..3)
-                        .map(|a| grid.cell_of(b.max, a) - grid.cell_of(b.min, a) + 1)
-                        .product::<usize>()
+                    let (lo, hi) = grid.cell_range(&padded(b, pad));
+                    (0..3).map(|a| hi[a] - lo[a] + 1).product::<usize>()
                 })
                 .fold(0usize, usize::saturating_add);
             if candidates <= bound || res == [1; 3] {
@@ -108,6 +106,14 @@ impl Grid {
         grid
     }
 
+    /// The first and last cells, along each axis, that box `b` overlaps.
+    fn cell_range(&self, b: &Aabb) -> ([usize; 3], [usize; 3]) {
+        (
+            [0, 1, 2].map(|a| self.cell_of(b.min, a)),
+            [0, 1, 2].map(|a| self.cell_of(b.max, a)),
+        )
+    }
+
     fn cell_of(&self, p: Vec3A, axis: usize) -> usize {
         let x = ((p[axis] - self.bounds.min[axis]) / self.cell_size[axis]).floor();
         (x.max(0.0) as usize).min(self.res[axis] - 1)
@@ -135,8 +141,7 @@ impl Grid {
     ) {
         for &(i, bounds) in items {
             let b = padded(&bounds, pad);
-            let lo = [0, 1, 2].map(|a| self.cell_of(b.min, a));
-            let hi = [0, 1, 2].map(|a| self.cell_of(b.max, a));
+            let (lo, hi) = self.cell_range(&b);
             let single = lo == hi;
             for z in lo[2]..=hi[2] {
                 for y in lo[1]..=hi[1] {
