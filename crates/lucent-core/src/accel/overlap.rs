@@ -79,43 +79,99 @@ pub fn triangle_overlaps_box(p: &[Vec3A; 3], b: &Aabb) -> bool {
     true
 }
 
-/// Bounds of the part of the primitive inside `b`, or `None` if it does not overlap.
+/// The part of a primitive inside a box, as a kd-tree's build prices it.
+#[derive(Clone, Copy, Debug)]
+pub struct Clipped {
+    pub bounds: Aabb,
+    /// The part is a segment or a point (of no area; within rounding): the triangle
+    /// only touches the box, along an edge or at a corner, as a mesh's neighbour does
+    /// across the plane that made the box. Never set for other shapes.
+    pub touches_only: bool,
+}
+
+/// The part of the primitive inside `b`, or `None` if it does not overlap.
 /// Triangles are clipped (Sutherland–Hodgman against the six planes); other shapes
 /// use their bounding box cut to `b`.
-pub fn clipped_bounds<P: PrimitiveSet + ?Sized>(prims: &P, i: u32, b: &Aabb) -> Option<Aabb> {
+pub fn clipped_bounds<P: PrimitiveSet + ?Sized>(prims: &P, i: u32, b: &Aabb) -> Option<Clipped> {
     match prims.triangle(i) {
         Some(p) => clip_triangle(&p, b),
         None => {
             let pb = prims.bounds(i);
-            boxes_overlap(&pb, b).then(|| Aabb {
-                min: pb.min.max(b.min),
-                max: pb.max.min(b.max),
+            boxes_overlap(&pb, b).then(|| Clipped {
+                bounds: Aabb {
+                    min: pb.min.max(b.min),
+                    max: pb.max.min(b.max),
+                },
+                touches_only: false,
             })
         }
     }
 }
 
-fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Aabb> {
-    let mut poly: Vec<DVec3> = p.iter().map(|&v| d(v)).collect();
+/// Twice the vector area of a polygon (Newell's sum): its length is twice the area.
+fn vector_area(poly: &[DVec3]) -> DVec3 {
+    let mut n = DVec3::ZERO;
+    for (i, a) in poly.iter().enumerate() {
+        n += a.cross(poly[(i + 1) % poly.len()]);
+    }
+    n
+}
+
+/// A clipped part this much smaller than its triangle (in area) counts as no area: the
+/// part of a triangle that touches the box is made of copies of its corners and points
+/// on its edges, whose rounding leaves far less.
+const NO_AREA: f64 = 1e-9;
+
+/// The corners a clipped triangle may have: each plane adds at most one corner to a
+/// convex polygon, nine in all, with room for a few more (rounding can make the polygon
+/// slightly non-convex; past this, the triangle's bounds are used, see below). Kept on
+/// the stack: the kd-tree's build clips every primitive a plane straddles, and an
+/// allocation a pass took a third of its time.
+const MAX_CLIPPED: usize = 16;
+
+fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Clipped> {
+    let (mut a, mut c) = ([DVec3::ZERO; MAX_CLIPPED], [DVec3::ZERO; MAX_CLIPPED]);
+    // (The two buffers change roles by reference: swapping the arrays themselves
+    // copied them, at every pass.)
+    let (mut poly, mut out) = (&mut a, &mut c);
+    for (q, &v) in poly.iter_mut().zip(p) {
+        *q = d(v);
+    }
+    let mut len = 3;
     let (lo, hi) = (d(b.min), d(b.max));
     for axis in 0..3 {
         for (plane, keep_above) in [(lo[axis], true), (hi[axis], false)] {
             let inside = |q: &DVec3| if keep_above { q[axis] >= plane } else { q[axis] <= plane };
-            let mut out = Vec::with_capacity(poly.len() + 1);
-            for i in 0..poly.len() {
-                let (a, c) = (poly[i], poly[(i + 1) % poly.len()]);
+            let mut n = 0;
+            for i in 0..len {
+                let (a, c) = (poly[i], poly[(i + 1) % len]);
+                if n + 2 > MAX_CLIPPED {
+                    // Only a polygon bent by rounding gets here: the triangle's own
+                    // bounds within the box hold its clipped part.
+                    let whole = Aabb::EMPTY.grow(p[0]).grow(p[1]).grow(p[2]);
+                    return Some(Clipped {
+                        bounds: Aabb {
+                            min: whole.min.max(b.min),
+                            max: whole.max.min(b.max),
+                        },
+                        touches_only: false,
+                    });
+                }
                 if inside(&a) {
-                    out.push(a);
+                    out[n] = a;
+                    n += 1;
                 }
                 if inside(&a) != inside(&c) {
                     let t = (plane - a[axis]) / (c[axis] - a[axis]);
                     let mut q = a + (c - a) * t;
                     q[axis] = plane;
-                    out.push(q);
+                    out[n] = q;
+                    n += 1;
                 }
             }
-            poly = out;
-            if poly.is_empty() {
+            std::mem::swap(&mut poly, &mut out);
+            len = n;
+            if len == 0 {
                 return None;
             }
         }
@@ -123,13 +179,17 @@ fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Aabb> {
     // The clipped bounds only place candidate split planes (which cell a primitive goes
     // to is decided by `overlaps`), so rounding to nearest is fine; never beyond the box.
     let mut r = Aabb::EMPTY;
-    for q in poly {
+    for q in &poly[..len] {
         let q = Vec3A::new(q.x as f32, q.y as f32, q.z as f32);
         r = r.grow(q);
     }
-    Some(Aabb {
-        min: r.min.max(b.min),
-        max: r.max.min(b.max),
+    let whole = vector_area(&[d(p[0]), d(p[1]), d(p[2])]).length();
+    Some(Clipped {
+        bounds: Aabb {
+            min: r.min.max(b.min),
+            max: r.max.min(b.max),
+        },
+        touches_only: vector_area(&poly[..len]).length() <= NO_AREA * whole,
     })
 }
 
@@ -150,7 +210,7 @@ mod tests {
             let clip = clip_triangle(&p, &b);
             // Clipping can lose a sliver that only touches the box within rounding.
             assert!(clip.is_none() || sat, "{p:?}");
-            if let Some(cb) = clip {
+            if let Some(Clipped { bounds: cb, .. }) = clip {
                 assert!(cb.min.cmpge(b.min).all() && cb.max.cmple(b.max).all());
                 inside += 1;
             } else if !sat {
@@ -163,7 +223,9 @@ mod tests {
                 let q = p[0] + (p[1] - p[0]) * u + (p[2] - p[0]) * v;
                 if q.cmpge(b.min).all() && q.cmple(b.max).all() {
                     assert!(sat, "sample {k} of {p:?} is in the box but SAT says disjoint");
-                    assert!(clip.is_some_and(|cb| cb.min.cmple(q + 1e-5).all() && cb.max.cmpge(q - 1e-5).all()));
+                    assert!(
+                        clip.is_some_and(|c| c.bounds.min.cmple(q + 1e-5).all() && c.bounds.max.cmpge(q - 1e-5).all())
+                    );
                     break;
                 }
             }
