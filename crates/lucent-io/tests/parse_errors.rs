@@ -572,3 +572,15 @@ fn nurbs_surfaces() {
         assert_eq!(first_error(text), msg, "{text}");
     }
 }
+
+#[test]
+fn quad_lights_as_large_as_single_precision_holds_are_lights() {
+    // An area of 4·10³⁶: the edges' cross product is representable, the sum of its
+    // components' squares is not (it was refused as having no area).
+    let huge = messages(&format!("{HEADER}quadLight 0 0 0 2e18 0 0 0 2e18 0 1 1 1\n"), false);
+    assert!(huge.iter().all(|m| !m.contains(": error: ")), "{huge:?}");
+    assert_eq!(
+        first_error("quadLight 0 0 0 1e20 0 0 0 1e20 0 1 1 1"),
+        "t.test:3:1: error: quadLight: the transformed light is too large: its area is beyond single precision (about 3.4e38)"
+    );
+}

@@ -84,16 +84,24 @@ pub struct QuadLight {
 }
 
 impl QuadLight {
-    /// `None` for a degenerate parallelogram (zero area).
+    /// `None` for a degenerate parallelogram (zero area) and for one whose area (or
+    /// an edge's cross product) is beyond `f32`.
     pub fn new(corner: Vec3A, ab: Vec3A, ac: Vec3A, radiance: Color) -> Option<QuadLight> {
         let n = ab.cross(ac);
-        let area = n.length();
-        (area > 0.0 && area.is_finite()).then(|| QuadLight {
+        // Scaled before squaring: a cross product of components beyond 1.8·10¹⁹ is
+        // representable, but the sum of their squares is not.
+        let scale = n.abs().max_element();
+        if !(scale > 0.0 && scale.is_finite()) {
+            return None;
+        }
+        let unit = n / scale;
+        let area = scale * unit.length();
+        area.is_finite().then(|| QuadLight {
             corner,
             ab,
             ac,
             radiance,
-            normal: n / area,
+            normal: unit.normalize(),
             area,
         })
     }

@@ -5,7 +5,7 @@
 
 use lucent_core::geometry::primitive::{Primitive, Shape};
 use lucent_core::light::{Light, QuadLight};
-use lucent_core::math::Color;
+use lucent_core::math::{Color, Vec3A};
 use lucent_core::shading::material::Material;
 
 use super::to_f32;
@@ -41,7 +41,12 @@ pub fn lights(
             LightKind::Quad { a, ab, ac, color } => {
                 let (a, ab, ac) = (to_f32(t.point(a)), to_f32(t.vector(ab)), to_f32(t.vector(ac)));
                 let Some(q) = QuadLight::new(a, ab, ac, to_f32(color)) else {
-                    diags.error(l.loc, "quadLight: the transformed light has no area");
+                    let why = if ab.cross(ac) == Vec3A::ZERO {
+                        "has no area"
+                    } else {
+                        "is too large: its area is beyond single precision (about 3.4e38)"
+                    };
+                    diags.error(l.loc, format!("quadLight: the transformed light {why}"));
                     continue;
                 };
                 lights.push(Light::Quad(q));
