@@ -88,20 +88,25 @@ impl QuadLight {
     /// an edge's cross product) is beyond `f32`.
     pub fn new(corner: Vec3A, ab: Vec3A, ac: Vec3A, radiance: Color) -> Option<QuadLight> {
         let n = ab.cross(ac);
-        // Scaled before squaring: a cross product of components beyond 1.8·10¹⁹ is
-        // representable, but the sum of their squares is not.
-        let scale = n.abs().max_element();
-        if !(scale > 0.0 && scale.is_finite()) {
-            return None;
-        }
-        let unit = n / scale;
-        let area = scale * unit.length();
-        area.is_finite().then(|| QuadLight {
+        let (normal, area) = match n.length() {
+            area if area > 0.0 && area.is_finite() => (n / area, area),
+            _ => {
+                // Scaled before squaring: a cross product of components beyond
+                // 1.8·10¹⁹ is representable, but the sum of their squares is not.
+                let scale = n.abs().max_element();
+                if !(scale > 0.0 && scale.is_finite()) {
+                    return None;
+                }
+                let unit = n / scale;
+                (unit.normalize(), scale * unit.length())
+            }
+        };
+        area.is_finite().then_some(QuadLight {
             corner,
             ab,
             ac,
             radiance,
-            normal: unit.normalize(),
+            normal,
             area,
         })
     }
@@ -286,6 +291,23 @@ impl Light {
 mod tests {
     use super::*;
     use crate::sampling::chi2::chi2_test_edged;
+
+    #[test]
+    fn quad_lights_of_every_size_single_precision_holds_have_their_area() {
+        let white = Color::ONE;
+        for (edge, area) in [(1e-12f32, 1e-24f32), (1.0, 1.0), (2e18, 4e36), (1.8e19, 3.24e38)] {
+            let q = QuadLight::new(Vec3A::ZERO, Vec3A::X * edge, Vec3A::Y * edge, white)
+                .unwrap_or_else(|| panic!("edges of {edge}"));
+            assert!((q.area / area - 1.0).abs() < 1e-6, "edges of {edge}: area {}", q.area);
+            assert!(
+                (q.normal - Vec3A::Z).length() < 1e-6,
+                "edges of {edge}: normal {}",
+                q.normal
+            );
+        }
+        assert!(QuadLight::new(Vec3A::ZERO, Vec3A::X * 2e19, Vec3A::Y * 2e19, white).is_none());
+        assert!(QuadLight::new(Vec3A::ZERO, Vec3A::X, Vec3A::X * 2.0, white).is_none());
+    }
 
     #[test]
     fn point_lights_attenuate_and_directional_lights_do_not() {
