@@ -7,8 +7,8 @@
 //! `C_trav + C_isect·(1 − bonus)·(P_below·N_below + P_above·N_above)` (a bonus for cutting
 //! off empty space); a node becomes a leaf when no plane is cheaper than testing all its
 //! primitives, or at depth `8 + 1.3·log₂ N`. Primitives that only touch a node are not
-//! priced, and a node is not peeled (one side keeping all it holds while the other holds
-//! some): see [`best_plane`]. A primitive that straddles the plane goes to each side it
+//! priced, and a node is not peeled (one side keeping every priced item while the other
+//! holds some): see [`best_plane`]. A primitive that straddles the plane goes to each side it
 //! really overlaps (the exact triangle–box test), on padded boxes.
 //!
 //! Traversal (Havran's recursive ray traversal, iterative): the ray's `[t_min, t_max]`

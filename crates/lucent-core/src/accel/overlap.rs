@@ -83,7 +83,7 @@ pub fn triangle_overlaps_box(p: &[Vec3A; 3], b: &Aabb) -> bool {
 #[derive(Clone, Copy, Debug)]
 pub struct Clipped {
     pub bounds: Aabb,
-    /// The part is a segment or a point (of no area; within rounding): the triangle
+    /// The part is a segment or a point (no area beside the box's faces: [`NO_AREA`]): the triangle
     /// only touches the box, along an edge or at a corner, as a mesh's neighbour does
     /// across the plane that made the box. Never set for other shapes.
     pub touches_only: bool,
@@ -117,9 +117,11 @@ fn vector_area(poly: &[DVec3]) -> DVec3 {
     n
 }
 
-/// A clipped part this much smaller than its triangle (in area) counts as no area: the
-/// part of a triangle that touches the box is made of copies of its corners and points
-/// on its edges, whose rounding leaves far less.
+/// A clipped part this much smaller (in area) than the box's largest face counts as no
+/// area: the part of a triangle that touches the box is made of copies of its corners
+/// and points on its edges, whose rounding leaves far less; a sliver this thin is seldom
+/// hit. (Measured against the box, not the triangle: a large triangle crossing a small
+/// box has a part small beside the triangle, but not beside the box.)
 const NO_AREA: f64 = 1e-9;
 
 /// The corners a clipped triangle may have: each plane adds at most one corner to a
@@ -183,13 +185,14 @@ fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Clipped> {
         let q = Vec3A::new(q.x as f32, q.y as f32, q.z as f32);
         r = r.grow(q);
     }
-    let whole = vector_area(&[d(p[0]), d(p[1]), d(p[2])]).length();
+    let e = hi - lo;
+    let largest_face = (e.x * e.y).max(e.y * e.z).max(e.z * e.x);
     Some(Clipped {
         bounds: Aabb {
             min: r.min.max(b.min),
             max: r.max.min(b.max),
         },
-        touches_only: vector_area(&poly[..len]).length() <= NO_AREA * whole,
+        touches_only: 0.5 * vector_area(&poly[..len]).length() <= NO_AREA * largest_face,
     })
 }
 
