@@ -581,6 +581,6 @@ fn quad_lights_as_large_as_single_precision_holds_are_lights() {
     assert!(huge.iter().all(|m| !m.contains(": error: ")), "{huge:?}");
     assert_eq!(
         first_error("quadLight 0 0 0 1e20 0 0 0 1e20 0 1 1 1"),
-        "t.test:3:1: error: quadLight: the transformed light is too large: its area is beyond single precision (about 3.4e38)"
+        "t.test:3:1: error: quadLight: the transformed light is too large: its area, or its edges' products, beyond single precision (about 3.4e38)"
     );
 }

@@ -44,7 +44,7 @@ pub fn lights(
                     let why = if ab.cross(ac) == Vec3A::ZERO {
                         "has no area"
                     } else {
-                        "is too large: its area is beyond single precision (about 3.4e38)"
+                        "is too large: its area, or its edges' products, beyond single precision (about 3.4e38)"
                     };
                     diags.error(l.loc, format!("quadLight: the transformed light {why}"));
                     continue;
