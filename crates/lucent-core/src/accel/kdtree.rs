@@ -180,7 +180,7 @@ impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
 /// children's areas add up to the parent's) peel off slice after slice to the depth
 /// limit: a slice holding one triangle and the neighbour touching its face was split
 /// again because its wider part then held one item instead of two. A flat mesh of
-/// 80,000 triangles took 19 entries a triangle and 3.7 s to build.
+/// 80,000 triangles took 3.7 s and 18 MB to build.
 ///
 /// Nor is a node peeled: split where one side keeps every priced item and the other
 /// some of them. The side that keeps them all is the same problem in a smaller box, and
