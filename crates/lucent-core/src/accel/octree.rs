@@ -113,8 +113,12 @@ impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
                     .collect()
             })
             .collect();
-        if children.iter().all(|c| c.len() == items.len() || c.is_empty()) {
-            // Cutting separates nothing (every primitive spans the centre).
+        let holding = children.iter().filter(|c| !c.is_empty()).count();
+        if holding > 1 && children.iter().all(|c| c.len() == items.len() || c.is_empty()) {
+            // Cutting separates nothing (every primitive spans the centre). (Everything
+            // in one octant is cut on: the cut took empty space away. Taken for
+            // "nothing", it left a mesh alone in a large cell one leaf of all its
+            // triangles.)
             return leaf(self, &items);
         }
         // The children's entries replace this cell's. A cut that puts the cell's
@@ -307,6 +311,22 @@ mod tests {
         let largest_leaf = tree.nodes.iter().filter(|c| c.count != INTERIOR).map(|c| c.count).max();
         let entries = tree.prim_ids.len() as f64 / n as f64;
         assert!(entries < 6.0, "{entries:.2} entries a triangle");
+        assert!(largest_leaf <= Some(64), "a leaf of {largest_leaf:?}");
+    }
+
+    #[test]
+    fn an_object_alone_in_a_large_cell_is_cut_on() {
+        // Two small clusters of triangles far apart: each ends alone in one octant of
+        // its cell, level after level, until the cells fit it.
+        let mut tris = Vec::new();
+        for centre in [Vec3A::ZERO, Vec3A::splat(20.0)] {
+            tris.extend((0..2_000).map(|k| {
+                let c = centre + Vec3A::new((k % 40) as f32, (k / 40) as f32, (k % 7) as f32) * 0.01;
+                [c, c + Vec3A::X * 0.01, c + Vec3A::Y * 0.01]
+            }));
+        }
+        let tree = Octree::build(&Triangles(tris));
+        let largest_leaf = tree.nodes.iter().filter(|c| c.count != INTERIOR).map(|c| c.count).max();
         assert!(largest_leaf <= Some(64), "a leaf of {largest_leaf:?}");
     }
 }
