@@ -291,6 +291,11 @@ mod tests {
         }
     }
 
+    /// The most primitives a leaf of `tree` holds.
+    fn largest_leaf(tree: &Octree) -> Option<u32> {
+        tree.nodes.iter().filter(|c| c.count != INTERIOR).map(|c| c.count).max()
+    }
+
     #[test]
     fn a_flat_mesh_lies_in_one_layer_of_cells() {
         // A floor of 20,000 triangles at z = 0. In its own box (as thin as the padding)
@@ -308,7 +313,7 @@ mod tests {
             .collect();
         let n = flat.len();
         let tree = Octree::build(&Triangles(flat));
-        let largest_leaf = tree.nodes.iter().filter(|c| c.count != INTERIOR).map(|c| c.count).max();
+        let largest_leaf = largest_leaf(&tree);
         let entries = tree.prim_ids.len() as f64 / n as f64;
         assert!(entries < 6.0, "{entries:.2} entries a triangle");
         assert!(largest_leaf <= Some(64), "a leaf of {largest_leaf:?}");
@@ -326,7 +331,7 @@ mod tests {
             }));
         }
         let tree = Octree::build(&Triangles(tris));
-        let largest_leaf = tree.nodes.iter().filter(|c| c.count != INTERIOR).map(|c| c.count).max();
+        let largest_leaf = largest_leaf(&tree);
         assert!(largest_leaf <= Some(64), "a leaf of {largest_leaf:?}");
     }
 }

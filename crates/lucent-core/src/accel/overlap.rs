@@ -150,7 +150,7 @@ fn clip_triangle(p: &[Vec3A; 3], b: &Aabb) -> Option<Clipped> {
                 if n + 2 > MAX_CLIPPED {
                     // Only a polygon bent by rounding gets here: the triangle's own
                     // bounds within the box hold its clipped part.
-                    let whole = Aabb::EMPTY.grow(p[0]).grow(p[1]).grow(p[2]);
+                    let whole = Aabb::from_points(p);
                     return Some(Clipped {
                         bounds: Aabb {
                             min: whole.min.max(b.min),
