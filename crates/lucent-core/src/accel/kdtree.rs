@@ -9,7 +9,8 @@
 //! primitives, or at depth `8 + 1.3·log₂ N`. Primitives that only touch a node are not
 //! priced, and a node is not peeled when that separates little (one side keeping every
 //! priced item while the other holds at least half): see [`best_plane`]. A primitive that straddles the plane goes to each side it
-//! really overlaps (the exact triangle–box test), on padded boxes.
+//! really overlaps (the exact triangle–box test), on boxes padded by their own
+//! [`overlap::cell_padding`].
 //!
 //! Traversal (Havran's recursive ray traversal, iterative): the ray's `[t_min, t_max]`
 //! interval is cut at each split plane; the near child is visited first and the far one
@@ -57,7 +58,6 @@ struct Item {
 
 struct Builder<'a, P: ?Sized> {
     prims: &'a P,
-    pad: f32,
     max_depth: usize,
     nodes: Vec<KdNode>,
     prim_ids: Vec<u32>,
@@ -72,7 +72,6 @@ impl KdTree {
         let count = items.len();
         let mut builder = Builder {
             prims,
-            pad: cell_padding(&bounds),
             max_depth: (8.0 + 1.3 * (count.max(1) as f32).log2()).round() as usize,
             nodes: Vec::new(),
             prim_ids: Vec::new(),
@@ -137,12 +136,13 @@ impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
         below: &Aabb,
         above: &Aabb,
     ) -> (Vec<Item>, Vec<Item>) {
-        let (pb, pa) = (padded(below, self.pad), padded(above, self.pad));
+        let pad = cell_padding(&below.union(above));
+        let (pb, pa) = (padded(below, pad), padded(above, pad));
         let (mut lo, mut hi) = (Vec::new(), Vec::new());
         for it in items {
-            if it.b.max[axis] < pos - self.pad {
+            if it.b.max[axis] < pos - pad {
                 lo.push(it);
-            } else if it.b.min[axis] > pos + self.pad {
+            } else if it.b.min[axis] > pos + pad {
                 hi.push(it);
             } else {
                 for (side, padded_side, out) in [(below, &pb, &mut lo), (above, &pa, &mut hi)] {
@@ -328,6 +328,17 @@ mod tests {
                 })
                 .collect(),
         )
+    }
+
+    #[test]
+    fn a_small_detail_in_a_large_scene_is_padded_by_its_own_size() {
+        // 5,000 triangles 0.01 wide and one 10⁴ away: padded by the scene's size (0.12),
+        // every triangle fell into the cells on both sides of each plane near it (117.9
+        // entries a triangle; now 1.1).
+        let prims = Triangles::detail_in_a_stadium(7, 5_000);
+        let tree = KdTree::build(&prims);
+        let entries = tree.prim_ids.len() as f64 / prims.0.len() as f64;
+        assert!(entries < 4.0, "{entries:.2} entries a triangle");
     }
 
     #[test]

@@ -28,6 +28,21 @@ impl Triangles {
                 .collect(),
         )
     }
+
+    /// A "teapot in a stadium": `n` random triangles about 0.01 wide in the unit cube, and
+    /// one more 10⁴ away, so that the scene is a million times the detail's size.
+    pub fn detail_in_a_stadium(seed: u64, n: usize) -> Triangles {
+        let mut rng = Rng(seed);
+        let mut tris: Vec<[Vec3A; 3]> = (0..n)
+            .map(|_| {
+                let c = rng.vec(0.5) + Vec3A::splat(0.5);
+                [c + rng.vec(0.01), c + rng.vec(0.01), c + rng.vec(0.01)]
+            })
+            .collect();
+        let far = Vec3A::splat(1e4);
+        tris.push([far, far + Vec3A::X, far + Vec3A::Y]);
+        Triangles(tris)
+    }
 }
 
 impl PrimitiveSet for Triangles {

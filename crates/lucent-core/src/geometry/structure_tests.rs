@@ -272,6 +272,61 @@ fn rays_starting_on_a_surface_match_the_list() {
 }
 
 #[test]
+fn a_small_detail_in_a_large_scene_matches_the_list() {
+    // A "teapot in a stadium": 1,500 triangles about 0.01 wide in the unit cube and two
+    // 10⁴ away. The kd-tree and the octree pad each cell by its own size, not the
+    // scene's (which padded this detail by 0.12): camera rays from near and far, rays
+    // along the axes, and rays leaving the hit points, the closest to the cells' planes.
+    let mut rng = Rng(4242);
+    let tri = |p: [Vec3A; 3]| Primitive::new(Shape::Triangle { p, normals: None }, 0);
+    let mut prims: Vec<Primitive> = (0..1500)
+        .map(|_| {
+            let c = rng.vec(0.5) + Vec3A::splat(0.5);
+            tri([c + rng.vec(0.01), c + rng.vec(0.01), c + rng.vec(0.01)])
+        })
+        .collect();
+    let far = Vec3A::splat(1e4);
+    prims.push(tri([far, far + Vec3A::X * 100.0, far + Vec3A::Y * 100.0]));
+    prims.push(tri([-far, -far + Vec3A::Z * 100.0, -far + Vec3A::Y * 100.0]));
+    let mut rays = Vec::new();
+    for k in 0..3000 {
+        // A point on one of the detail's triangles (most such rays hit it or another).
+        let Shape::Triangle { p, .. } = &prims[k % 1500].shape else {
+            unreachable!()
+        };
+        let (b1, b2) = (rng.next(), rng.next());
+        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+        let target = p[0] + (p[1] - p[0]) * b1 + (p[2] - p[0]) * b2;
+        let o = match k % 3 {
+            0 => target + rng.vec(2.0),
+            1 => rng.vec(1e4),
+            _ => {
+                let mut o = target;
+                o[k % 5 % 3] -= 3.0;
+                o
+            }
+        };
+        rays.push(Ray::segment(o, (target - o).normalize(), 1e-4, f32::INFINITY));
+    }
+    let list = PrimitiveList::new(prims.as_slice());
+    let leaving: Vec<Ray> = rays
+        .iter()
+        .filter_map(|r| {
+            list.closest_hit(prims.as_slice(), &PreparedRay::new(*r))
+                .map(|h| r.at(h.t))
+        })
+        .flat_map(|p| {
+            let d = rng.vec(1.0).normalize();
+            [Ray::segment(p, d, 1e-6, f32::INFINITY), Ray::segment(p, d, 0.0, 0.05)]
+        })
+        .collect();
+    assert!(leaving.len() > 1000, "{}", leaving.len());
+    rays.extend(leaving);
+    let hits = check_against_list(&prims, &rays);
+    assert!(hits > 1000, "{hits}");
+}
+
+#[test]
 fn rays_leaving_a_huge_floor_match_the_list_and_never_find_it() {
     // The CSE168 dragon's kind of floor: two triangles 2,000 units across near y = −5,
     // under a soup, tilted by 0.01 so that their boxes have height (a ray leaving a flat
