@@ -27,10 +27,16 @@ const MAX_LEAF: usize = 8;
 /// made leaves of hundreds). The entry budget bounds the tree, not the depth.
 const MAX_DEPTH: usize = 32;
 /// The most primitive entries the cells may hold, per primitive: a cut that would take
-/// the tree past it makes a leaf instead. A primitive lies in every octant it
+/// its cell's share past it makes a leaf instead. A primitive lies in every octant it
 /// touches, and cells thinner than their padding (a flat scene's, or around primitives
 /// that meet at a point) pass it to both halves, level after level: without a bound,
 /// nine primitives meeting at a point made 4¹⁶ cells.
+///
+/// The bound is shared out: a cell's subtree may add entries in proportion to the
+/// entries it holds. One bound for the whole tree was spent where cutting never
+/// separates (around the vertices of a floor whose every triangle is stacked 50 times,
+/// cut down to the depth limit) before the rest of the scene was built, which was left
+/// in leaves of hundreds.
 const MAX_ENTRIES_PER_PRIM: usize = 64;
 /// Each level pushes at most three octants.
 const STACK_SIZE: usize = 3 * MAX_DEPTH + 4;
@@ -86,12 +92,12 @@ struct Builder<'a, P: ?Sized> {
     boxes: Vec<Aabb>,
     nodes: Vec<OctNode>,
     prim_ids: Vec<u32>,
-    /// Entries the tree may still add by cutting (see [`MAX_ENTRIES_PER_PRIM`]).
-    budget: usize,
 }
 
 impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
-    fn build(&mut self, me: usize, cell: &Aabb, items: Vec<u32>, depth: usize) {
+    /// Makes node `me` the tree over `items` in `cell`, which may add `budget` entries by
+    /// cutting (see [`MAX_ENTRIES_PER_PRIM`]).
+    fn build(&mut self, me: usize, cell: &Aabb, items: Vec<u32>, depth: usize, budget: usize) {
         let leaf = |b: &mut Self, items: &[u32]| {
             b.nodes[me] = OctNode {
                 first: b.prim_ids.len() as u32,
@@ -128,10 +134,11 @@ impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
         // primitives into four children each, on average, separates too little to pay.
         let entries = children.iter().map(Vec::len).sum::<usize>();
         let growth = entries.saturating_sub(items.len());
-        if entries > 4 * items.len() || growth > self.budget {
+        if entries == 0 || entries > 4 * items.len() || growth > budget {
             return leaf(self, &items);
         }
-        self.budget -= growth;
+        // What is left is shared out by the entries each child holds.
+        let left = (budget - growth) as u128;
         let first = self.nodes.len();
         self.nodes[me] = OctNode {
             first: first as u32,
@@ -139,7 +146,8 @@ impl<P: PrimitiveSet + ?Sized> Builder<'_, P> {
         };
         self.nodes.extend([OctNode { first: 0, count: 0 }; 8]);
         for (i, c) in children.into_iter().enumerate() {
-            self.build(first + i, &octant(cell, i), c, depth + 1);
+            let share = (left * c.len() as u128 / entries as u128) as usize;
+            self.build(first + i, &octant(cell, i), c, depth + 1, share);
         }
     }
 }
@@ -164,9 +172,9 @@ impl Octree {
             boxes,
             nodes: vec![OctNode { first: 0, count: 0 }],
             prim_ids: Vec::new(),
-            budget: (MAX_ENTRIES_PER_PRIM - 1) * items.len(),
         };
-        b.build(0, &bounds, items, 0);
+        let budget = (MAX_ENTRIES_PER_PRIM - 1) * items.len();
+        b.build(0, &bounds, items, 0, budget);
         Octree {
             bounds,
             nodes: b.nodes,
@@ -330,6 +338,26 @@ mod tests {
         let tree = Octree::build(&prims);
         let largest_leaf = largest_leaf(&tree);
         assert!(largest_leaf <= Some(64), "a leaf of {largest_leaf:?}");
+    }
+
+    #[test]
+    fn stacked_copies_do_not_spend_the_whole_trees_entries() {
+        // A floor of 40 × 40 squares whose every triangle is there 20 times. Around its
+        // vertices cutting never separates, and with one budget for the whole tree the
+        // cells there took all of it down to the depth limit: the rest of the floor was
+        // left in leaves of up to 17,640 (64.0 entries a triangle). Now the largest leaf
+        // holds the copies of the six triangles that meet at a vertex (120; 36.6 entries).
+        let mut tris = Vec::new();
+        for k in 0..1600 {
+            let c = Vec3A::new((k % 40) as f32, (k / 40) as f32, 0.0);
+            for _ in 0..20 {
+                tris.push([c, c + Vec3A::X, c + Vec3A::Y]);
+                tris.push([c + Vec3A::X, c + Vec3A::ONE.with_z(0.0), c + Vec3A::Y]);
+            }
+        }
+        let tree = Octree::build(&Triangles(tris));
+        let largest_leaf = largest_leaf(&tree);
+        assert!(largest_leaf <= Some(200), "a leaf of {largest_leaf:?}");
     }
 
     #[test]
