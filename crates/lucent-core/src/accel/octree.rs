@@ -7,19 +7,22 @@
 //! separates too little (its octants hold four times the cell's primitives), or the
 //! tree holds [`MAX_ENTRIES_PER_PRIM`] entries a primitive.
 //!
-//! Traversal (in the spirit of Revelles, Ureña & Lastra 2000): inside a cell the ray
-//! starts in the octant that holds its entry point and crosses the three mid-planes in
-//! the order of their distances, each crossing flipping one bit of the octant index — so
-//! the (at most four) octants it passes are visited in order along the ray, each with
-//! its own part of the ray's interval. The search ends when the closest hit lies before
-//! the next octant.
+//! Traversal: front to back. Inside a cell the octants the ray may enter — by the
+//! conservative slab test of each octant's box, the test the root's box passes — are
+//! visited in the order of their entry distances (at most four along a line; more only
+//! where rounding makes a crossing a near tie). The search skips every cell that lies
+//! beyond the closest hit. (Octants chosen by the order of the mid-plane crossings, as
+//! Revelles, Ureña & Lastra 2000 do, lost an octant near a corner when rounding put one
+//! crossing on the wrong side of another; the cells' padding, a millionth of their own
+//! coordinates, does not cover rounding that grows with the ray's distance.)
 
 use super::cell_walk::CellWalk;
 use super::overlap::{cell_padding, overlaps, padded};
 use super::{search_limit, PrimitiveSet};
 use crate::aabb::Aabb;
-use crate::math::Vec3A;
+use crate::math::{gamma, Vec3A};
 use crate::ray::PreparedRay;
+use std::mem::MaybeUninit;
 
 const MAX_LEAF: usize = 8;
 /// Cells down to 2⁻³² of the root's side: a detail a millionth of the scene's size still
@@ -38,8 +41,8 @@ const MAX_DEPTH: usize = 32;
 /// cut down to the depth limit) before the rest of the scene was built, which was left
 /// in leaves of hundreds.
 const MAX_ENTRIES_PER_PRIM: usize = 64;
-/// Each level pushes at most three octants.
-const STACK_SIZE: usize = 3 * MAX_DEPTH + 4;
+/// Each level pops one cell and pushes at most eight octants.
+const STACK_SIZE: usize = 7 * MAX_DEPTH + 8;
 const INTERIOR: u32 = u32::MAX;
 
 /// Interior: `first` = index of the first of eight consecutive children (octant `i` has
@@ -184,6 +187,35 @@ impl Octree {
     }
 }
 
+/// Along each axis, the ray's interval in the lower and the upper half of `cell`: the
+/// slab test of [`Aabb::intersect`] (its far distances widened by `1 + 2γ(3)`) for the
+/// eight octants at once, from the nine plane distances they share. An axis the ray
+/// does not move along (or so little that `1/d` overflows) admits the halves that hold
+/// the origin, faces included.
+fn half_intervals(cell: &Aabb, r: &PreparedRay) -> ([[f32; 2]; 3], [[f32; 2]; 3]) {
+    const WIDEN: f32 = 1.0 + 2.0 * gamma(3);
+    let (o, inv, mid) = (r.ray.origin, r.inv_dir, cell.centroid());
+    let mut near = [[0.0f32; 2]; 3];
+    let mut far = [[0.0f32; 2]; 3];
+    for a in 0..3 {
+        let planes = [cell.min[a], mid[a], cell.max[a]];
+        if r.zero_axes.test(a) || !inv[a].is_finite() {
+            for h in 0..2 {
+                let inside = planes[h] <= o[a] && o[a] <= planes[h + 1];
+                near[a][h] = if inside { f32::NEG_INFINITY } else { f32::INFINITY };
+                far[a][h] = f32::INFINITY;
+            }
+        } else {
+            let t = planes.map(|p| (p - o[a]) * inv[a]);
+            for h in 0..2 {
+                near[a][h] = t[h].min(t[h + 1]);
+                far[a][h] = t[h].max(t[h + 1]) * WIDEN;
+            }
+        }
+    }
+    (near, far)
+}
+
 impl CellWalk for Octree {
     #[inline(always)]
     fn walk(&self, r: &PreparedRay, mut leaf: impl FnMut(&[u32]) -> Option<f32>) {
@@ -191,19 +223,23 @@ impl CellWalk for Octree {
             return;
         }
         let ray = &r.ray;
-        let Some((t0, t1)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
+        let Some((t0, _)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
             return;
         };
-        // (node, cell, entry, exit), nearest on top.
-        let mut stack = [(0u32, Aabb::EMPTY, 0.0f32, 0.0f32); STACK_SIZE];
-        stack[0] = (0, self.bounds, t0, t1);
+        // (node, cell, entry), nearest on top. Uninitialised: a ray reaches a few dozen
+        // of its entries, and filling them all would cost more than the walk.
+        let mut stack = [const { MaybeUninit::<(u32, Aabb, f32)>::uninit() }; STACK_SIZE];
+        stack[0].write((0, self.bounds, t0));
         let mut sp = 1;
         let mut limit = f32::INFINITY;
         while sp > 0 {
             sp -= 1;
-            let (node, cell, t0, t1) = stack[sp];
+            // SAFETY: the entries below `sp` were written (pushes write before they count).
+            let (node, cell, t0) = unsafe { stack[sp].assume_init_read() };
             if limit < t0 {
-                return;
+                // This cell lies beyond the closest hit (those below it on the stack
+                // nearly all do too, but rounding may order siblings' entries either way).
+                continue;
             }
             let n = self.nodes[node as usize];
             if n.count != INTERIOR {
@@ -214,41 +250,32 @@ impl CellWalk for Octree {
                 }
                 continue;
             }
-            let mid = cell.centroid();
-            let mut t_mid = [f32::INFINITY; 3];
-            let mut octant_index = 0usize;
-            for a in 0..3 {
-                let d = ray.dir[a];
-                let above = if d == 0.0 {
-                    ray.origin[a] >= mid[a]
-                } else {
-                    t_mid[a] = (mid[a] - ray.origin[a]) * r.inv_dir[a];
-                    // Moving up, the ray is in the upper half once past the plane.
-                    (d > 0.0) == (t0 >= t_mid[a])
-                };
-                octant_index |= (above as usize) << a;
-            }
-            // The mid-plane crossings inside (t0, t1), in order.
-            let mut crossings: [(f32, usize); 3] = [(0.0, 0); 3];
+            // Every octant the ray may enter, by the conservative slab test of its box (the
+            // test the root passed): an octant chosen by the order of the mid-plane
+            // crossings alone was dropped when rounding, which grows with the ray's
+            // distance, put a crossing on the wrong side of another, near a corner.
+            let (near, far) = half_intervals(&cell, r);
+            let t_far = search_limit(ray.t_max);
+            let mut visits = [(0usize, 0.0f32); 8];
             let mut k = 0;
-            for (a, &t) in t_mid.iter().enumerate() {
-                if t > t0 && t < t1 {
-                    crossings[k] = (t, a);
+            for o in 0..8 {
+                let child = self.nodes[n.first as usize + o];
+                if child.count == 0 {
+                    continue;
+                }
+                let h = [o & 1, o >> 1 & 1, o >> 2 & 1];
+                let enter = near[0][h[0]].max(near[1][h[1]]).max(near[2][h[2]]).max(ray.t_min);
+                let exit = far[0][h[0]].min(far[1][h[1]]).min(far[2][h[2]]).min(t_far);
+                // (An octant beyond the closest hit found is not even pushed.)
+                if enter <= exit && enter <= limit {
+                    visits[k] = (o, enter);
                     k += 1;
                 }
             }
-            crossings[..k].sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-            // Octants in ray order with their intervals; pushed farthest first.
-            let mut visits = [(0usize, 0.0f32, 0.0f32); 4];
-            let mut enter = t0;
-            for (j, &(t, a)) in crossings[..k].iter().enumerate() {
-                visits[j] = (octant_index, enter, t);
-                octant_index ^= 1 << a;
-                enter = t;
-            }
-            visits[k] = (octant_index, enter, t1);
-            for &(o, a, b) in visits[..=k].iter().rev() {
-                stack[sp] = (n.first + o as u32, octant(&cell, o), a, b);
+            visits[..k].sort_unstable_by(|x, y| x.1.total_cmp(&y.1));
+            // Farthest pushed first; at most eight a level, one of them popped next.
+            for &(o, enter) in visits[..k].iter().rev() {
+                stack[sp].write((n.first + o as u32, octant(&cell, o), enter));
                 sp += 1;
             }
         }
