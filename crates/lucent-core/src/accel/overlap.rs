@@ -11,15 +11,19 @@ use crate::aabb::Aabb;
 use crate::math::{DVec3, Vec3A};
 
 /// How much a box grows before primitives are assigned to it: a hundred-thousandth of
-/// its size and a millionth of its largest coordinate (about sixteen units in the last
-/// place of an `f32` there), far above the rounding of the split planes and the ray's
-/// distances to them, and far below the box.
+/// its size and a millionth of its largest coordinate (eight to sixteen units in the
+/// last place of an `f32` there), far above the rounding of its planes and far below
+/// the box.
 ///
-/// The grid pads its cells by the scene box's padding (its cells are the scene's
-/// divided evenly). The kd-tree and the octree pad each cell by its own: with the
-/// scene's, a small detail far from the origin's largest coordinate — 50,000 triangles
-/// 0.01 wide in a unit cube, with one more triangle 10⁴ away — was padded by 0.12, so
-/// every triangle fell into the cells on both sides of every plane near it.
+/// The kd-tree and the octree pad each cell by its own: their walks decide which cells
+/// a ray enters with a margin of their own for the rounding of the ray's distances,
+/// which grows with the distance (the kd-tree a relative 2⁻¹² at each plane, the octree
+/// the conservative slab test of each octant). With the scene's padding, a small detail
+/// far from the scene's largest coordinate — 50,000 triangles 0.01 wide in a unit cube,
+/// with one more triangle 10⁴ away — was padded by 0.12, so every triangle fell into the
+/// cells on both sides of every plane near it. The grid's walk (a 3-D DDA from the cell
+/// of the entry point) has no such margin, so its cells keep the scene box's padding,
+/// which covers the rounding of distances across the scene.
 pub fn cell_padding(b: &Aabb) -> f32 {
     let e = b.extent().max_element();
     let m = b.min.abs().max(b.max.abs()).max_element();
