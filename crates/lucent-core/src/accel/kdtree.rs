@@ -345,7 +345,7 @@ mod tests {
     fn a_flat_mesh_is_not_cut_into_slivers() {
         // Before its items that only touch a node went unpriced and peels that separate
         // little were refused, the kd-tree held about 17 entries a triangle of these
-        // floors (18.3, 17.4 and 17.0) in 18 nodes a triangle; now 6.3–6.7 in 3.6. (The coplanar-grid property
+        // floors (18.3, 17.4 and 17.0) in 18 nodes a triangle; now 6.0–6.6 in 3.6. (The coplanar-grid property
         // test in `geometry::structure_tests` checks such a tree's answers.)
         for n in [20, 40, 60] {
             let prims = floor(n);

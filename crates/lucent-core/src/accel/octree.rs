@@ -338,7 +338,7 @@ mod tests {
         // A floor of 20,000 triangles at z = 0. In its own box (as thin as the padding)
         // every cut passed every triangle to both halves along z; the tree spent its 64
         // entries a triangle on copies and left leaves of thousands (64.0 entries, a leaf
-        // of 5,202; now 4.2 and 8).
+        // of 5,202; now 4.1 and 8).
         let flat: Vec<[Vec3A; 3]> = (0..10_000)
             .flat_map(|k| {
                 let c = Vec3A::new((k % 100) as f32, (k / 100) as f32, 0.0);
