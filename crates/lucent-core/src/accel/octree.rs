@@ -223,7 +223,8 @@ impl CellWalk for Octree {
             return;
         }
         let ray = &r.ray;
-        let Some((t0, _)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
+        let t_far = search_limit(ray.t_max);
+        let Some((t0, _)) = self.bounds.intersect(r, t_far) else {
             return;
         };
         // (node, cell, entry), nearest on top. Uninitialised: a ray reaches a few dozen
@@ -255,7 +256,6 @@ impl CellWalk for Octree {
             // crossings alone was dropped when rounding, which grows with the ray's
             // distance, put a crossing on the wrong side of another, near a corner.
             let (near, far) = half_intervals(&cell, r);
-            let t_far = search_limit(ray.t_max);
             let mut visits = [(0usize, 0.0f32); 8];
             let mut k = 0;
             for o in 0..8 {

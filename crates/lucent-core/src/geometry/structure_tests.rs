@@ -273,21 +273,20 @@ fn rays_starting_on_a_surface_match_the_list() {
 
 #[test]
 fn a_small_detail_in_a_large_scene_matches_the_list() {
-    // A "teapot in a stadium": 1,500 triangles about 0.01 wide in the unit cube and two
-    // 10⁴ away. The kd-tree and the octree pad each cell by its own size, not the
-    // scene's (which padded this detail by 0.12): camera rays from near and very far,
-    // rays along the axes, and rays leaving the hit points.
-    let mut rng = Rng(4242);
+    // A "teapot in a stadium": 1,500 triangles about 0.01 wide in the unit cube, one 10⁴
+    // away and one more on the other side. The kd-tree and the octree pad each cell by
+    // its own size, not the scene's (which padded this detail by 0.12): camera rays from
+    // near and very far, rays along the axes, and rays leaving the hit points.
+    use crate::accel::test_sets::Triangles;
     let tri = |p: [Vec3A; 3]| Primitive::new(Shape::Triangle { p, normals: None }, 0);
-    let mut prims: Vec<Primitive> = (0..1500)
-        .map(|_| {
-            let c = rng.vec(0.5) + Vec3A::splat(0.5);
-            tri([c + rng.vec(0.01), c + rng.vec(0.01), c + rng.vec(0.01)])
-        })
+    let mut prims: Vec<Primitive> = Triangles::detail_in_a_stadium(4242, 1500)
+        .0
+        .into_iter()
+        .map(tri)
         .collect();
     let far = Vec3A::splat(1e4);
-    prims.push(tri([far, far + Vec3A::X * 100.0, far + Vec3A::Y * 100.0]));
     prims.push(tri([-far, -far + Vec3A::Z * 100.0, -far + Vec3A::Y * 100.0]));
+    let mut rng = Rng(4243);
     let mut rays = Vec::new();
     for k in 0..4000 {
         // A point on one of the detail's triangles (most such rays hit it or another).
