@@ -2,22 +2,32 @@
 //!
 //! Build: the scene box (volume `V`) is cut into cells of equal size, `(λ·N / V)^(1/3)`
 //! per unit of length along every axis (λ = 3): about `λ·N` cells in all, so about
-//! `λ^(1/3)·N^(1/3)` per axis, more along the box's long sides. Each primitive is entered into every
+//! `λ^(1/3)·N^(1/3)` per axis, more along the box's long sides. An axis along which the
+//! box is thinner than a cell gets one cell, and the others share the `λ·N` (a flat
+//! scene's grid is a grid of its plane). Each primitive is entered into every
 //! cell it overlaps — its bounding box picks the candidates, the exact triangle–box test
 //! decides — in one flat array with an offset per cell. When the primitives' boxes
 //! would put more than 64 entries a primitive into the cells (primitives that overlap,
 //! at worst all at one place), the cells are made larger until they do not.
 //!
+//! A crowded cell (more than [`NESTED_AT`] primitives, and many more than the average)
+//! gets a grid of its own over the part of it they fill, built by the same rules (down to
+//! [`MAX_LEVEL`] levels below the scene's), where that pays: a uniform
+//! grid's cells follow the scene's size, so a small detail in a large scene — 50,000
+//! triangles 0.01 wide beside one 10⁴ away — fell into one cell, and every ray that
+//! reached it tested all of them (a 160 × 120 render took 25 s; the BVH's, 0.2 s).
+//!
 //! Traversal: 3-D DDA (Amanatides & Woo 1987) from the cell where the ray enters, always
-//! stepping across the nearest cell wall, so cells are visited in ray order; the search
-//! ends when the closest hit lies inside the current cell. Mailboxing ([`Mailbox`])
-//! tests a primitive that spans several cells once per ray.
+//! stepping across the nearest cell wall, so cells are visited in ray order (a cell's
+//! own grid is walked in its place, the same way); the search ends when the closest hit
+//! lies inside the current cell. Mailboxing ([`Mailbox`]) tests a primitive that spans
+//! several cells once per ray.
 
 use super::cell_walk::CellWalk;
 use super::overlap::{cell_padding, overlaps, padded};
 use super::{search_limit, PrimitiveSet};
 use crate::aabb::Aabb;
-use crate::math::Vec3A;
+use crate::math::{DVec3, Vec3A};
 use crate::ray::PreparedRay;
 
 /// Cells per primitive.
@@ -25,6 +35,36 @@ const DENSITY: f32 = 3.0;
 const MAX_RES: usize = 512;
 /// The most cell entries a primitive may make on average (see [`Grid::build`]).
 const MAX_ENTRIES_PER_PRIM: usize = 64;
+/// A cell gets its own grid when it holds more primitives than this, and more than
+/// [`NESTED_CROWD`] times as many as the grid's cells on average: a detail crowded into
+/// few cells of a scene much larger than it. (Where every cell is crowded alike — long
+/// slivers, a mesh longer than 512 cells — grids in all of them took seconds to build
+/// and a hundred bytes a triangle, for little.)
+const NESTED_AT: usize = 128;
+const NESTED_CROWD: usize = 8;
+/// A cell's own grid is not made where its cells would hold each primitive more than
+/// this many times on average (slivers as long as the cell, primitives that overlap):
+/// the rays would meet most of them in every cell they cross.
+const NESTED_SPREAD: usize = 24;
+/// The cells and entries (4 bytes each) all nested grids may add, per primitive.
+const NESTED_WORDS_PER_PRIM: usize = 16;
+/// The scene's grid is level 0; grids in its cells level 1, and so on up to this.
+const MAX_LEVEL: usize = 2;
+/// [`Grid::nested`] of a cell without a grid of its own.
+const NONE: u32 = u32::MAX;
+/// A bound on the relative rounding of the walk's f64 arithmetic: each position and
+/// distance it computes takes at most four roundings of 2⁻⁵³ of the magnitudes it is
+/// computed from (see [`Grid::walk_from`]).
+const ROUNDING: f64 = 1.0 / (1u64 << 50) as f64;
+/// How far from the exact ray, relative to the distance travelled and the primitive's
+/// size, a hit the primitive tests accept may lie. The watertight triangle test works in
+/// f32 on the corners translated to the ray's origin and sheared: each projected corner
+/// is off by at most about 7 ulps of its distance from the origin, and each edge
+/// function's sign by about 4 ulps of the triangle's size, so a hit is within
+/// 2⁻²¹·(distance + 2·size) of the exact ray; this allows twice that. (The ray from
+/// 10⁶ away that a small detail's grid must not miss is 2 units wide by this measure, as
+/// it is to the BVH's box tests, whose offsets widen by 2⁻¹⁸ of `o/d`.)
+const PRIMITIVE_SLACK: f64 = 1.0 / (1u64 << 20) as f64;
 
 pub struct Grid {
     bounds: Aabb,
@@ -33,35 +73,61 @@ pub struct Grid {
     /// Primitives of cell `c`: `prim_ids[cell_start[c]..cell_start[c + 1]]`.
     cell_start: Vec<u32>,
     prim_ids: Vec<u32>,
+    /// Cell `c`'s own grid, `grids[nested[c]]`, or [`NONE`]; empty when no cell has one.
+    nested: Vec<u32>,
+    grids: Vec<Grid>,
     prim_count: usize,
+    /// The largest extent of a primitive in this grid (its whole box, not its part in a
+    /// cell): the walk's allowance for the primitive tests' rounding grows with it.
+    largest: f32,
 }
 
 impl Grid {
     pub fn build<P: PrimitiveSet + ?Sized>(prims: &P) -> Grid {
         let items: Vec<(u32, Aabb)> = super::bounded(prims).collect();
         let scene = items.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b));
+        let mut budget = NESTED_WORDS_PER_PRIM * items.len();
+        Grid::build_level(prims, &items, scene, 0, &mut budget).expect("level 0 always has a grid")
+    }
+
+    /// The grid over `items` in `scene` (their bounds, or their part in a cell of the
+    /// level above), its crowded cells given grids of their own. Above level 0 (a cell's
+    /// own grid), `None` where it would not pay: where its cells would hold each
+    /// primitive more than [`NESTED_SPREAD`] times, where one cell keeps them all, or
+    /// where its cells and entries do not fit `budget` (which they are taken from).
+    fn build_level<P: PrimitiveSet + ?Sized>(
+        prims: &P,
+        items: &[(u32, Aabb)],
+        scene: Aabb,
+        level: usize,
+        budget: &mut usize,
+    ) -> Option<Grid> {
         if items.is_empty() {
-            return Grid {
+            return Some(Grid {
                 bounds: Aabb::EMPTY,
                 res: [1; 3],
                 cell_size: Vec3A::ONE,
                 cell_start: vec![0, 0],
                 prim_ids: Vec::new(),
+                nested: Vec::new(),
+                grids: Vec::new(),
                 prim_count: 0,
-            };
+                largest: 0.0,
+            });
         }
         let pad = cell_padding(&scene);
         let bounds = padded(&scene, pad);
         let ext = bounds.extent();
-        // Flat scenes have no volume: give thin axes a token thickness for the estimate.
-        // In f64: in f32 the volume of a scene under about 1e-13 across is subnormal, and
-        // under 1e-15 zero, which made every axis MAX_RES cells (512³ for one primitive).
-        let e = ext.max(Vec3A::splat(ext.max_element() * 1e-3)).as_dvec3();
-        let mut per_unit = (DENSITY as f64 * items.len() as f64 / (e.x * e.y * e.z)).cbrt();
+        let largest = items
+            .iter()
+            .map(|&(i, _)| prims.bounds(i).extent().max_element())
+            .fold(0.0f32, f32::max);
+        let mut per_unit = cells_per_unit(ext.as_dvec3(), DENSITY as f64 * items.len() as f64);
         // Primitives that overlap (at worst all at one place) each span many cells: N of
         // them in N cells would make N² entries (12,000 spheres at one point, 1.7 GB). The
         // cells are halved along every axis until their candidates fit the bound.
         let bound = (MAX_ENTRIES_PER_PRIM * items.len()).clamp(1 << 12, u32::MAX as usize / 2);
+        let mut first = true;
         let mut grid = loop {
             let res = [0, 1, 2].map(|a| ((ext[a] as f64 * per_unit).round() as usize).clamp(1, MAX_RES));
             let grid = Grid {
@@ -70,7 +136,10 @@ impl Grid {
                 cell_size: ext / Vec3A::new(res[0] as f32, res[1] as f32, res[2] as f32),
                 cell_start: Vec::new(),
                 prim_ids: Vec::new(),
+                nested: Vec::new(),
+                grids: Vec::new(),
                 prim_count: prims.count(),
+                largest,
             };
             let candidates = items
                 .iter()
@@ -79,6 +148,13 @@ impl Grid {
                     (0..3).map(|a| hi[a] - lo[a] + 1).product::<usize>()
                 })
                 .fold(0usize, usize::saturating_add);
+            if level > 0 {
+                let cells = res.iter().product::<usize>();
+                if first && candidates > NESTED_SPREAD * items.len() || cells + candidates > *budget {
+                    return None;
+                }
+                first = false;
+            }
             if candidates <= bound || res == [1; 3] {
                 break grid;
             }
@@ -88,7 +164,7 @@ impl Grid {
         // Two passes: count the entries of every cell, then fill them in.
         let cells = res[0] * res[1] * res[2];
         let mut count = vec![0u32; cells + 1];
-        grid.for_each_entry(prims, &items, pad, |c, _| count[c] += 1);
+        grid.for_each_entry(prims, items, pad, |c, _| count[c] += 1);
         let mut start = 0u32;
         for c in count.iter_mut() {
             let n = *c;
@@ -97,13 +173,82 @@ impl Grid {
         }
         let mut fill = count.clone();
         let mut ids = vec![0u32; start as usize];
-        grid.for_each_entry(prims, &items, pad, |c, p| {
+        grid.for_each_entry(prims, items, pad, |c, p| {
             ids[fill[c] as usize] = p;
             fill[c] += 1;
         });
         grid.cell_start = count;
         grid.prim_ids = ids;
-        grid
+        if level > 0 {
+            if grid.largest_cell() >= items.len() {
+                return None;
+            }
+            *budget = budget.saturating_sub(grid.cell_start.len() + grid.prim_ids.len());
+        }
+        if level < MAX_LEVEL {
+            grid.nest(prims, level, budget);
+        }
+        Some(grid)
+    }
+
+    /// The most primitives one cell holds.
+    fn largest_cell(&self) -> usize {
+        self.cell_start
+            .windows(2)
+            .map(|w| (w[1] - w[0]) as usize)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Gives each crowded cell (see [`NESTED_AT`]) a grid of its own over the part of the
+    /// cell its primitives fill, where that pays (see [`Grid::build_level`]).
+    fn nest<P: PrimitiveSet + ?Sized>(&mut self, prims: &P, level: usize, budget: &mut usize) {
+        let cells = self.cell_start.len() - 1;
+        let crowded = NESTED_AT.max(NESTED_CROWD * self.prim_ids.len() / cells);
+        for c in 0..cells {
+            let ids = &self.prim_ids[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+            if ids.len() <= crowded {
+                continue;
+            }
+            let [x, y, z] = self.cell_coords(c);
+            let cell = self.cell_box([x, y, z]);
+            let items: Vec<(u32, Aabb)> = ids
+                .iter()
+                .map(|&i| {
+                    let b = prims.bounds(i);
+                    let clipped = Aabb {
+                        min: b.min.max(cell.min),
+                        max: b.max.min(cell.max),
+                    };
+                    // A primitive the padding put here may lie just outside the cell.
+                    (
+                        i,
+                        if clipped.min.cmple(clipped.max).all() {
+                            clipped
+                        } else {
+                            b
+                        },
+                    )
+                })
+                .collect();
+            let region = items.iter().fold(Aabb::EMPTY, |acc, (_, b)| acc.union(b));
+            let Some(inner) = Grid::build_level(prims, &items, region, level + 1, budget) else {
+                continue;
+            };
+            if self.nested.is_empty() {
+                self.nested = vec![NONE; self.cell_start.len() - 1];
+            }
+            self.nested[c] = self.grids.len() as u32;
+            self.grids.push(inner);
+        }
+    }
+
+    fn cell_coords(&self, c: usize) -> [usize; 3] {
+        [
+            c % self.res[0],
+            c / self.res[0] % self.res[1],
+            c / (self.res[0] * self.res[1]),
+        ]
     }
 
     /// The first and last cells, along each axis, that box `b` overlaps.
@@ -157,60 +302,95 @@ impl Grid {
     }
 }
 
+/// Cells per unit of length for about `cells` cells in a box of extent `ext`, an axis
+/// along which the box is thinner than one cell getting one. In f64: in f32 the volume
+/// of a scene under about 1e-13 across is subnormal, and under 1e-15 zero, which made
+/// every axis [`MAX_RES`] cells (512³ for one primitive).
+///
+/// (Flat boxes were given a token thickness, a thousandth of their size, which made a
+/// flat region's cells a fraction of its triangles' size: each triangle of a floor lay
+/// in dozens.)
+fn cells_per_unit(ext: DVec3, cells: f64) -> f64 {
+    let mut thick = [0, 1, 2].map(|a| ext[a] > 0.0);
+    let mut per_unit = 1.0;
+    // Each pass may find more axes thinner than a cell (at most all three).
+    for _ in 0..3 {
+        let k = thick.iter().filter(|&&t| t).count();
+        if k == 0 {
+            break;
+        }
+        let volume: f64 = (0..3).filter(|&a| thick[a]).map(|a| ext[a]).product();
+        per_unit = (cells / volume).powf(1.0 / k as f64);
+        let thin = (0..3)
+            .filter(|&a| thick[a] && ext[a] * per_unit < 1.0)
+            .collect::<Vec<_>>();
+        if thin.is_empty() {
+            break;
+        }
+        for a in thin {
+            thick[a] = false;
+        }
+    }
+    per_unit
+}
+
+/// One axis of a grid as its walk sees it (f64).
+struct Axis {
+    index: usize,
+    lo: f64,
+    hi: f64,
+    size: f64,
+    inv_size: f64,
+    /// The rounding of a cell division, at most.
+    slack: f64,
+    last: usize,
+}
+
+impl Axis {
+    /// The cells that coordinates `from..=to` (already widened by their own error)
+    /// touch, widened by the rounding of the cell division; `None` when they lie outside
+    /// the grid.
+    #[inline(always)]
+    fn cells(&self, from: f64, to: f64) -> Option<(usize, usize)> {
+        let (from, to) = (from - self.slack, to + self.slack);
+        if !(to >= self.lo && from <= self.hi) {
+            return None;
+        }
+        Some((self.cell(from), self.cell(to)))
+    }
+
+    /// The cells that fractional cell coordinates `from..=to` (already widened by their
+    /// error) touch; `None` when they lie outside the grid.
+    #[inline(always)]
+    fn cell_range(&self, from: f64, to: f64) -> Option<(usize, usize)> {
+        if !(to >= 0.0 && from < (self.last + 1) as f64) {
+            return None;
+        }
+        let of = |u: f64| if u > 0.0 { (u as usize).min(self.last) } else { 0 };
+        Some((of(from), of(to)))
+    }
+
+    /// The cell of coordinate `x`, clamped to the grid. (Truncation is the floor of a
+    /// non-negative quotient; `floor` itself is a library call on CPUs without SSE4.1,
+    /// which the default build allows for.)
+    #[inline(always)]
+    fn cell(&self, x: f64) -> usize {
+        let q = (x - self.lo) * self.inv_size;
+        if q > 0.0 {
+            (q as usize).min(self.last)
+        } else {
+            0
+        }
+    }
+}
+
 impl CellWalk for Grid {
     #[inline(always)]
     fn walk(&self, r: &PreparedRay, mut cell: impl FnMut(&[u32]) -> Option<f32>) {
         if self.prim_count == 0 {
             return;
         }
-        let ray = &r.ray;
-        let Some((t0, _)) = self.bounds.intersect(r, search_limit(ray.t_max)) else {
-            return;
-        };
-        let entry = ray.at(t0);
-        let mut c = [0, 1, 2].map(|a| self.cell_of(entry, a));
-        let mut step = [0isize; 3];
-        let mut next_t = [f32::INFINITY; 3];
-        let wall = |c: usize, a: usize| self.bounds.min[a] + c as f32 * self.cell_size[a];
-        for a in 0..3 {
-            if ray.dir[a] > 0.0 {
-                step[a] = 1;
-                next_t[a] = (wall(c[a] + 1, a) - ray.origin[a]) * r.inv_dir[a];
-            } else if ray.dir[a] < 0.0 {
-                step[a] = -1;
-                next_t[a] = (wall(c[a], a) - ray.origin[a]) * r.inv_dir[a];
-            }
-        }
-        loop {
-            let i = self.index(c);
-            let ids = &self.prim_ids[self.cell_start[i] as usize..self.cell_start[i + 1] as usize];
-            let Some(limit) = cell(ids) else { return };
-            let a = if next_t[0] < next_t[1] {
-                if next_t[0] < next_t[2] {
-                    0
-                } else {
-                    2
-                }
-            } else if next_t[1] < next_t[2] {
-                1
-            } else {
-                2
-            };
-            let exit = next_t[a];
-            // The closest hit lies in this cell, or the ray ends in it; or no wall lies
-            // ahead at a finite distance (the nearest is along an axis the ray does not
-            // move along: every distance overflowed).
-            if limit < exit || exit > search_limit(ray.t_max) || step[a] == 0 {
-                return;
-            }
-            let n = c[a] as isize + step[a];
-            if n < 0 || n >= self.res[a] as isize {
-                return;
-            }
-            c[a] = n as usize;
-            let w = if step[a] > 0 { c[a] + 1 } else { c[a] };
-            next_t[a] = (wall(w, a) - ray.origin[a]) * r.inv_dir[a];
-        }
+        self.walk_from(r, f32::INFINITY, &mut cell);
     }
 
     fn prim_count(&self) -> usize {
@@ -218,7 +398,209 @@ impl CellWalk for Grid {
     }
 
     fn memory_bytes(&self) -> usize {
-        (self.cell_start.len() + self.prim_ids.len()) * 4
+        (self.cell_start.len() + self.prim_ids.len() + self.nested.len()) * 4
+            + self.grids.iter().map(|g| CellWalk::memory_bytes(g)).sum::<usize>()
+    }
+}
+
+impl Grid {
+    /// Walks this grid's cells along the ray, the search limit `limit` so far (where the
+    /// closest hit found lies, or infinity). Returns the limit after its cells, or `None`
+    /// once `cell` has ended the search.
+    ///
+    /// Slab by slab across the axis the ray crosses most cells of (`m`), nearest slab
+    /// first; in each slab, every cell of the range of the two other axes that the ray's
+    /// part in the slab spans — one to four cells for most rays, about as many as a 3-D
+    /// DDA visits. The walk stops after the slab the ray leaves beyond the closest hit.
+    ///
+    /// It visits every cell that holds a hit the primitive tests can report: everything
+    /// is computed in f64 from the ray's own f32 values, each coordinate widened by a
+    /// bound on that rounding ([`ROUNDING`]) and by how far from the exact ray the f32
+    /// primitive tests may accept a hit ([`PRIMITIVE_SLACK`]), which grows with the
+    /// distance travelled. (A 3-D DDA in f32 from the entry point, the walk before, was
+    /// off by ulps of the distance — 0.06 from 10⁶ away — with no allowance but the
+    /// cells' padding, so the cells of a small detail could not be finer than the
+    /// scene's padding.) Rays whose allowance spans several cells visit them all.
+    #[inline(always)]
+    fn walk_from<F: FnMut(&[u32]) -> Option<f32>>(&self, r: &PreparedRay, mut limit: f32, cell: &mut F) -> Option<f32> {
+        let ray = &r.ray;
+        let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+        let (lo, hi) = (self.bounds.min.as_dvec3(), self.bounds.max.as_dvec3());
+        let largest = self.largest as f64;
+        // The primitive tests' allowance at the box's farthest corner (distances as sums
+        // of components: upper bounds).
+        let farthest = (o - lo).abs().max((o - hi).abs()).element_sum();
+        let box_slack = PRIMITIVE_SLACK * (farthest + 2.0 * largest);
+        // The part of the ray inside the grid's box (widened by that allowance), its
+        // ends widened by their rounding.
+        let mut t0 = ray.t_min as f64;
+        let mut t1 = search_limit(ray.t_max).min(limit) as f64;
+        for a in 0..3 {
+            let (lo, hi) = (lo[a] - box_slack, hi[a] + box_slack);
+            if d[a] == 0.0 {
+                if !(o[a] >= lo && o[a] <= hi) {
+                    return Some(limit);
+                }
+                continue;
+            }
+            let (near, far) = ((lo - o[a]) / d[a], (hi - o[a]) / d[a]);
+            let (near, far) = if near <= far { (near, far) } else { (far, near) };
+            t0 = t0.max(near - near.abs() * ROUNDING);
+            t1 = t1.min(far + far.abs() * ROUNDING);
+        }
+        if !(t0 <= t1) {
+            return Some(limit);
+        }
+        let size = self.cell_size.as_dvec3();
+        // The axis along which the ray crosses the most cells per unit of distance: in
+        // each of its slabs the ray moves by at most one cell along the other two.
+        let per_t = d.abs() / size;
+        let m = if per_t.x >= per_t.y && per_t.x >= per_t.z {
+            0
+        } else if per_t.y >= per_t.z {
+            1
+        } else {
+            2
+        };
+        let main = self.axis(m);
+        let minor = [self.axis((m + 1) % 3), self.axis((m + 2) % 3)];
+        let (om, sm) = (o[m], main.size);
+        let inv_dm = 1.0 / d[m];
+        // Distances along `m` are measured from the origin: `x`. The primitive tests'
+        // allowance at `x` is `slack_at(|x|)` (the distance bounded by the sum of the
+        // direction's components), and the error of a coordinate along `m` there,
+        // `error_m(|x|)`, adds the rounding of `om + x`.
+        let dist_per_x = d.abs().element_sum() * inv_dm.abs();
+        let slack_at = |x: f64| PRIMITIVE_SLACK * (x * dist_per_x + 2.0 * largest);
+        let error_m = |x: f64| (om.abs() + x) * ROUNDING + slack_at(x);
+        // The ray's span along `m`, from where it enters to where it leaves.
+        let (x0, x1) = ((t0 * d[m]), (t1 * d[m]));
+        let forward = d[m] > 0.0;
+        let (start, end) = if forward {
+            (x0 - error_m(x0.abs()), x1 + error_m(x1.abs()))
+        } else {
+            (x0 + error_m(x0.abs()), x1 - error_m(x1.abs()))
+        };
+        let Some((k_lo, k_hi)) = main.cells(om + start.min(end), om + start.max(end)) else {
+            return Some(limit);
+        };
+        // Wall `k` of `m` lies at `x = x_wall + k·sm`; where the ray crosses it, it is in
+        // cell `u0 + k·du` (fractional) of each other axis, off by at most
+        // `margin + margin_per_k·k` cells: the rounding of these sums (relative to their
+        // terms, which cancel when the origin is far), the primitive tests' allowance,
+        // and the allowance along `m` times the slope (a hit across a wall from the ray).
+        let x_wall = main.lo - om;
+        let x_reach = x_wall.abs();
+        let wall_error = error_m(x_reach) + main.lo.abs() * ROUNDING;
+        let wall_error_per_k = sm * (ROUNDING + PRIMITIVE_SLACK * dist_per_x);
+        let mut u0 = [0.0; 2];
+        let mut du = [0.0; 2];
+        let mut margin = [0.0; 2];
+        let mut margin_per_k = [0.0; 2];
+        for i in 0..2 {
+            let a = &minor[i];
+            let slope = d[a.index] * inv_dm;
+            let offset = o[a.index] - a.lo;
+            u0[i] = (offset + x_wall * slope) * a.inv_size;
+            du[i] = sm * slope * a.inv_size;
+            let rounding = 2.0 * ROUNDING * (offset.abs() + x_reach * slope.abs()) + ROUNDING * u0[i].abs() * a.size;
+            margin[i] = (rounding + slack_at(x_reach) + slope.abs() * wall_error) * a.inv_size;
+            margin_per_k[i] = (2.0 * ROUNDING * du[i].abs() * a.size
+                + PRIMITIVE_SLACK * sm * dist_per_x
+                + slope.abs() * wall_error_per_k)
+                * a.inv_size;
+        }
+        // The distance to wall `k`, `t_wall + k·dt`, less its error: the search ends
+        // once the closest hit lies before that at the slab's exit wall.
+        let (t_wall, dt) = (x_wall * inv_dm, sm * inv_dm);
+        let t_error = 2.0 * ROUNDING * t_wall.abs() + wall_error * inv_dm.abs();
+        let t_error_per_k = 2.0 * ROUNDING * dt.abs() + wall_error_per_k * inv_dm.abs();
+        let (mut k, last) = if forward { (k_lo, k_hi) } else { (k_hi, k_lo) };
+        let u_at = |i: usize, wall: f64| u0[i] + wall * du[i];
+        // Where the ray enters the first slab and leaves the last, in walls (a wall
+        // index with a fraction): the slab's whole width is not taken there, so that a
+        // ray leaving a surface does not visit the cells behind it.
+        let (first_wall, last_wall) = ((start - x_wall) / sm, (end - x_wall) / sm);
+        let mut u_in = [u_at(0, first_wall), u_at(1, first_wall)];
+        let mut at = [0usize; 3];
+        loop {
+            let out = if k == last {
+                last_wall
+            } else {
+                (if forward { k + 1 } else { k }) as f64
+            };
+            let u_out = [u_at(0, out), u_at(1, out)];
+            let far_wall = (k + 1) as f64;
+            let e = [0, 1].map(|i| margin[i] + margin_per_k[i] * far_wall);
+            let ranges =
+                [0, 1].map(|i| minor[i].cell_range(u_in[i].min(u_out[i]) - e[i], u_in[i].max(u_out[i]) + e[i]));
+            if let [Some((b0, b1)), Some((c0, c1))] = ranges {
+                let slab_slack = slack_at(x_reach + far_wall * sm);
+                at[m] = k;
+                for z in c0..=c1 {
+                    at[minor[1].index] = z;
+                    for y in b0..=b1 {
+                        at[minor[0].index] = y;
+                        let i = self.index(at);
+                        let list = &self.prim_ids[self.cell_start[i] as usize..self.cell_start[i + 1] as usize];
+                        // A cell's own grid (only crowded cells have one: the lookup is
+                        // made for those alone), unless the allowance spans its cells (a
+                        // ray from far away): its walk would visit most of them, and the
+                        // cell's list holds each primitive once.
+                        let inner = if list.len() > NESTED_AT {
+                            self.nested.get(i)
+                        } else {
+                            None
+                        };
+                        limit = match inner {
+                            Some(&g) if g != NONE && slab_slack < self.grids[g as usize].finest() => {
+                                self.grids[g as usize].walk_nested(r, limit, cell)?
+                            }
+                            _ => cell(list)?,
+                        };
+                    }
+                }
+            }
+            if k == last {
+                return Some(limit);
+            }
+            if (limit as f64) < t_wall + out * dt - (t_error + t_error_per_k * far_wall) {
+                return Some(limit);
+            }
+            u_in = u_out;
+            k = if forward { k + 1 } else { k - 1 };
+        }
+    }
+
+    /// What the walk needs of axis `a`.
+    #[inline(always)]
+    fn axis(&self, a: usize) -> Axis {
+        let (lo, hi) = (self.bounds.min[a] as f64, self.bounds.max[a] as f64);
+        let size = self.cell_size[a] as f64;
+        Axis {
+            index: a,
+            lo,
+            hi,
+            size,
+            inv_size: 1.0 / size,
+            slack: (lo.abs() + hi.abs()) * ROUNDING,
+            last: self.res[a] - 1,
+        }
+    }
+
+    /// The side of this grid's cells along their shortest axis of more than one cell
+    /// (infinite if none: a ray's allowance spans nothing there).
+    fn finest(&self) -> f64 {
+        (0..3)
+            .filter(|&a| self.res[a] > 1)
+            .map(|a| self.cell_size[a] as f64)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// [`Grid::walk_from`] for a cell's own grid: out of line, since it calls itself.
+    #[inline(never)]
+    fn walk_nested<F: FnMut(&[u32]) -> Option<f32>>(&self, r: &PreparedRay, limit: f32, cell: &mut F) -> Option<f32> {
+        self.walk_from(r, limit, cell)
     }
 }
 
@@ -236,6 +618,63 @@ mod tests {
             let grid = Grid::build(&Triangles(vec![tri; 2]));
             assert!(grid.res.iter().product::<usize>() <= 8, "{size}: {:?}", grid.res);
         }
+    }
+
+    /// The most primitives a ray from nearby meets in one cell of `grid` (cells with
+    /// grids of their own keep their lists for rays from far away).
+    fn largest_list(grid: &Grid) -> usize {
+        let own = (0..grid.cell_start.len() - 1)
+            .filter(|&c| grid.nested.get(c).is_none_or(|&g| g == NONE))
+            .map(|c| (grid.cell_start[c + 1] - grid.cell_start[c]) as usize);
+        own.chain(grid.grids.iter().map(largest_list)).max().unwrap_or(0)
+    }
+
+    #[test]
+    fn a_small_detail_in_a_large_scene_gets_a_grid_of_its_own() {
+        // 5,000 triangles 0.01 wide and one 10⁴ away: the scene's cells are about 500
+        // wide, and the detail lay in one (a list of 5,000).
+        let prims = Triangles::detail_in_a_stadium(7, 5_000);
+        let grid = Grid::build(&prims);
+        let largest = largest_list(&grid);
+        assert!(largest <= NESTED_AT, "a cell of {largest}");
+        assert!(grid.prim_ids.len() + grid.grids.iter().map(|g| g.prim_ids.len()).sum::<usize>() <= 64 * 2 * 5_001);
+    }
+
+    #[test]
+    fn a_flat_box_is_cut_in_its_plane_and_a_thin_one_along_its_length() {
+        let res = |ext: DVec3, cells: f64| {
+            let per_unit = cells_per_unit(ext, cells);
+            [0, 1, 2].map(|a| (ext[a] * per_unit).round() as usize)
+        };
+        assert_eq!(res(DVec3::new(10.0, 10.0, 1e-4), 300.0), [17, 17, 0]);
+        assert_eq!(res(DVec3::new(1e-4, 1000.0, 1e-4), 300.0), [0, 300, 0]);
+        assert_eq!(res(DVec3::splat(2.0), 27_000.0), [30, 30, 30]);
+        // A box with no extent at all (one point, unpadded) gets one cell per axis.
+        assert_eq!(res(DVec3::ZERO, 300.0), [0, 0, 0]);
+    }
+
+    #[test]
+    fn a_flat_detail_in_a_large_scene_gets_a_grid_of_its_plane() {
+        // A floor of 60 × 60 squares in the unit square and one triangle 10⁴ away. The
+        // detail lies in one of the scene's cells. Before flat boxes were cut in their
+        // plane (they were given a thousandth of their width as thickness), the grid
+        // in that cell would have had cells a fifth of a triangle's width, putting each
+        // into about 30 of them, and it was not made: a cell of 7,200.
+        let p = |i: usize, j: usize| Vec3A::new(i as f32 / 60.0, j as f32 / 60.0, 0.5);
+        let mut tris: Vec<[Vec3A; 3]> = (0..3600)
+            .flat_map(|k| {
+                let (i, j) = (k % 60, k / 60);
+                [
+                    [p(i, j), p(i + 1, j), p(i + 1, j + 1)],
+                    [p(i, j), p(i + 1, j + 1), p(i, j + 1)],
+                ]
+            })
+            .collect();
+        let far = Vec3A::splat(1e4);
+        tris.push([far, far + Vec3A::X, far + Vec3A::Y]);
+        let grid = Grid::build(&Triangles(tris));
+        let largest = largest_list(&grid);
+        assert!(largest <= NESTED_AT, "a cell of {largest}");
     }
 
     #[test]

@@ -329,6 +329,34 @@ fn a_small_detail_in_a_large_scene_matches_the_list() {
 }
 
 #[test]
+fn a_small_model_seen_from_far_away_matches_the_list() {
+    // 2,000 triangles about 0.01 wide in the unit cube, and rays aimed at them from 10⁴
+    // to 10⁷ away. The f32 tests a structure makes of such rays are off by ulps of the
+    // distance (0.06 from 10⁶), which the cells' padding (10⁻⁵ of the scene) does not
+    // cover: the grid's walk, a DDA in f32 from its entry point, lost 7 of 3,000 such
+    // hits from 10⁵ away and 1,644 from 10⁶; its walk now allows for its own rounding
+    // and for the primitive tests'.
+    use crate::accel::test_sets::Triangles;
+    let tri = |p: [Vec3A; 3]| Primitive::new(Shape::Triangle { p, normals: None }, 0);
+    let mut detail = Triangles::detail_in_a_stadium(777, 2000).0;
+    detail.truncate(2000);
+    let prims: Vec<Primitive> = detail.iter().map(|&p| tri(p)).collect();
+    let mut rng = Rng(778);
+    let mut rays = Vec::new();
+    for (k, p) in detail.iter().cycle().take(4000).enumerate() {
+        let (b1, b2) = (rng.next(), rng.next());
+        let (b1, b2) = if b1 + b2 > 1.0 { (1.0 - b1, 1.0 - b2) } else { (b1, b2) };
+        let target = p[0] + (p[1] - p[0]) * b1 + (p[2] - p[0]) * b2;
+        let dir = rng.vec(1.0).normalize();
+        let distance = [1e4, 1e5, 1e6, 1e7][k % 4];
+        rays.push(Ray::segment(target - dir * distance, dir, 1e-4, f32::INFINITY));
+    }
+    let hits = check_against_list(&prims, &rays);
+    // (From 10⁷ away an origin is rounded by about a unit: most of those rays miss.)
+    assert!(hits > 1800, "{hits}");
+}
+
+#[test]
 fn rays_leaving_a_huge_floor_match_the_list_and_never_find_it() {
     // The CSE168 dragon's kind of floor: two triangles 2,000 units across near y = −5,
     // under a soup, tilted by 0.01 so that their boxes have height (a ray leaving a flat
