@@ -10,18 +10,25 @@
 //! would put more than 64 entries a primitive into the cells (primitives that overlap,
 //! at worst all at one place), the cells are made larger until they do not.
 //!
-//! A crowded cell (more than [`NESTED_AT`] primitives, and many more than the average)
+//! A crowded cell (more than `NESTED_AT` primitives, and many more than the average)
 //! gets a grid of its own over the part of it they fill, built by the same rules (down to
-//! [`MAX_LEVEL`] levels below the scene's), where that pays: a uniform
+//! `MAX_LEVEL` levels below the scene's), where that pays: a uniform
 //! grid's cells follow the scene's size, so a small detail in a large scene — 50,000
 //! triangles 0.01 wide beside one 10⁴ away — fell into one cell, and every ray that
 //! reached it tested all of them (a 160 × 120 render took 25 s; the BVH's, 0.2 s).
 //!
-//! Traversal: 3-D DDA (Amanatides & Woo 1987) from the cell where the ray enters, always
-//! stepping across the nearest cell wall, so cells are visited in ray order (a cell's
-//! own grid is walked in its place, the same way); the search ends when the closest hit
-//! lies inside the current cell. Mailboxing ([`Mailbox`]) tests a primitive that spans
-//! several cells once per ray.
+//! Traversal: slab by slab across the axis along which the ray crosses the most cells,
+//! nearest slab first, visiting in each slab the cells of the range the ray spans along
+//! the two other axes (one to four for most rays, about as many as a 3-D DDA visits; a
+//! cell's own grid is walked in its place, the same way); the search ends after the slab
+//! the ray leaves beyond the closest hit. Mailboxing (`Mailbox`) tests a primitive that
+//! spans several cells once per ray. The walk is conservative: computed in f64 and
+//! widened by a bound on its own rounding and on how far from the exact ray the f32
+//! primitive tests may accept a hit (which grows with the distance), so it visits every
+//! cell that holds a hit whatever the cells' size and however far away the ray starts
+//! (see `Grid::walk_from`). The 3-D DDA it replaced (Amanatides & Woo 1987, in f32
+//! from the entry point) had no such allowance: a small model seen from 10⁵ times its
+//! size away lost hits, and the cells could not be finer than the scene's padding.
 
 use super::cell_walk::CellWalk;
 use super::overlap::{cell_padding, overlaps, padded};
@@ -543,6 +550,12 @@ impl Grid {
                         at[minor[0].index] = y;
                         let i = self.index(at);
                         let list = &self.prim_ids[self.cell_start[i] as usize..self.cell_start[i + 1] as usize];
+                        // (An empty cell changes nothing: `cell` would return the same
+                        // limit. Most cells a ray crosses are empty, and `cell` is not
+                        // inlined into this loop.)
+                        if list.is_empty() {
+                            continue;
+                        }
                         // A cell's own grid (only crowded cells have one: the lookup is
                         // made for those alone), unless the allowance spans its cells (a
                         // ray from far away): its walk would visit most of them, and the

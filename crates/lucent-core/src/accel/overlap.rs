@@ -21,9 +21,9 @@ use crate::math::{DVec3, Vec3A};
 /// the conservative slab test of each octant). With the scene's padding, a small detail
 /// far from the scene's largest coordinate — 50,000 triangles 0.01 wide in a unit cube,
 /// with one more triangle 10⁴ away — was padded by 0.12, so every triangle fell into the
-/// cells on both sides of every plane near it. The grid's walk (a 3-D DDA from the cell
-/// of the entry point) has no such margin, so its cells keep the scene box's padding,
-/// which covers the rounding of distances across the scene.
+/// cells on both sides of every plane near it. The grid pads its cells by the box it
+/// is built over (the scene's, or a crowded cell's part for a grid of its own); its
+/// walk allows for the rounding itself (`grid::Grid::walk_from`).
 pub fn cell_padding(b: &Aabb) -> f32 {
     let e = b.extent().max_element();
     let m = b.min.abs().max(b.max.abs()).max_element();
