@@ -463,6 +463,11 @@ impl Grid {
             return Some(limit);
         }
         let size = self.cell_size.as_dvec3();
+        if !(size.is_finite() && lo.is_finite() && hi.is_finite() && box_slack.is_finite()) {
+            // A scene whose extent overflows f32 (corners near ±3·10³⁸): its cells have
+            // no finite size, and the allowances no finite width.
+            return self.visit_all(limit, cell);
+        }
         // The axis along which the ray crosses the most cells per unit of distance: in
         // each of its slabs the ray moves by at most one cell along the other two.
         let per_t = d.abs() / size;
@@ -526,6 +531,19 @@ impl Grid {
         let (t_wall, dt) = (x_wall * inv_dm, sm * inv_dm);
         let t_error = 2.0 * ROUNDING * t_wall.abs() + wall_error * inv_dm.abs();
         let t_error_per_k = 2.0 * ROUNDING * dt.abs() + wall_error_per_k * inv_dm.abs();
+        if !(u0
+            .iter()
+            .chain(&du)
+            .chain(&margin)
+            .chain(&margin_per_k)
+            .all(|v| v.is_finite())
+            && t_error.is_finite()
+            && t_error_per_k.is_finite())
+        {
+            // (Overflow in f64 from finite f32 inputs is out of reach; NaN, from a zero
+            // times an infinite allowance, is kept from skipping cells all the same.)
+            return self.visit_all(limit, cell);
+        }
         let (mut k, last) = if forward { (k_lo, k_hi) } else { (k_hi, k_lo) };
         let u_at = |i: usize, wall: f64| u0[i] + wall * du[i];
         // Where the ray enters the first slab and leaves the last, in walls (a wall
@@ -592,6 +610,20 @@ impl Grid {
             u_in = u_out;
             k = if forward { k + 1 } else { k - 1 };
         }
+    }
+
+    /// Every cell's list, in order: what a ray sees of a grid whose walk cannot be
+    /// computed (see [`Grid::walk_from`]). Each primitive is tested once all the same.
+    #[cold]
+    #[inline(never)]
+    fn visit_all<F: FnMut(&[u32]) -> Option<f32>>(&self, mut limit: f32, cell: &mut F) -> Option<f32> {
+        for c in 0..self.cell_start.len() - 1 {
+            let list = &self.prim_ids[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+            if !list.is_empty() {
+                limit = cell(list)?;
+            }
+        }
+        Some(limit)
     }
 
     /// What the walk needs of axis `a`.
