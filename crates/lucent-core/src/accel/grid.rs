@@ -60,8 +60,8 @@ const MAX_LEVEL: usize = 2;
 /// [`Grid::nested`] of a cell without a grid of its own.
 const NONE: u32 = u32::MAX;
 /// A bound on the relative rounding of the walk's f64 arithmetic: each position and
-/// distance it computes takes at most four roundings of 2⁻⁵³ of the magnitudes it is
-/// computed from (see [`Grid::walk_from`]).
+/// distance it computes takes a handful of roundings of 2⁻⁵³ of the magnitudes it is
+/// computed from; this allows eight (see [`Grid::walk_from`]).
 const ROUNDING: f64 = 1.0 / (1u64 << 50) as f64;
 /// How far from the exact ray, relative to the distance travelled and the primitive's
 /// size, a hit the primitive tests accept may lie. The watertight triangle test works in

@@ -333,9 +333,10 @@ fn a_small_model_seen_from_far_away_matches_the_list() {
     // 2,000 triangles about 0.01 wide in the unit cube, and rays aimed at them from 10⁴
     // to 10⁷ away. The f32 tests a structure makes of such rays are off by ulps of the
     // distance (0.06 from 10⁶), which the cells' padding (10⁻⁵ of the scene) does not
-    // cover: the grid's walk, a DDA in f32 from its entry point, lost 7 of 3,000 such
-    // hits from 10⁵ away and 1,644 from 10⁶; its walk now allows for its own rounding
-    // and for the primitive tests'.
+    // cover: the grid's walk, a DDA in f32 from its entry point, lost 7 of 3,000 hits
+    // from 10⁵ away and 1,644 from 10⁶ (a probe of 20,000 such triangles; this test
+    // fails on it too); its walk now allows for its own rounding and for the primitive
+    // tests'.
     use crate::accel::test_sets::Triangles;
     let tri = |p: [Vec3A; 3]| Primitive::new(Shape::Triangle { p, normals: None }, 0);
     let mut detail = Triangles::detail_in_a_stadium(777, 2000).0;
