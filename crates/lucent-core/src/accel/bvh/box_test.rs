@@ -433,7 +433,7 @@ pub(super) mod tests {
                         check::<Slab<Avx>>("avx", &node, &r, &Slab::prepare(&rb, one), zero);
                         if let Some(offsets) = FmaOffsets::new(&pr) {
                             check::<Fused<Avx>>("avx+fma", &node, &r, &Fused::prepare(&rb, &offsets, one), false);
-                            if super::super::Isa::detect() == super::super::Isa::Avx512 {
+                            if super::super::Isa::detect().is_avx512() {
                                 // The same operations sixteen lanes wide: the same bound.
                                 check::<Fused<super::super::lanes::Avx512>>(
                                     "avx512+fma",

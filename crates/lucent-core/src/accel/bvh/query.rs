@@ -98,7 +98,7 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     run_fused::<Q, P, 8>(nodes, packets, prims, r, out)
 }
 
-/// The AVX-512 paths. Closest hits run the same code as [`run_avx2`] (the same 8-lane
+/// The AVX-512 paths over nodes of sixteen ([`Isa::Avx512`]). Closest hits run the same code as [`run_avx2`] (the same 8-lane
 /// operations, two groups per node), compiled with AVX-512 VL: 32 vector registers, so
 /// the ray's constants stay in registers, and comparisons into mask registers (measured
 /// on an AMD EPYC, Zen 4: 1.05–1.11× faster than the AVX2 build). Any-hit queries test
@@ -107,7 +107,9 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 /// read the children's entry distances back from memory to order them, and storing the
 /// distances as two 256-bit halves brought that to 0.975, so part of the loss is Zen 4
 /// forwarding a 512-bit store to the loads that follow; any-hit queries need no
-/// distances. (On a CPU with full-width AVX-512 this is still to be measured.)
+/// distances. (On an Intel Xeon with full-width AVX-512, closest hits as one 16-lane group
+/// were 1.02–1.10× faster than as two groups, but nodes of eight, [`run_avx512_nodes8`],
+/// 1.07–1.18×: there the tree has nodes of eight.)
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
@@ -134,8 +136,23 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     }
 }
 
-/// The body of [`run_avx2`] and of [`run_avx512`]'s closest hits, compiled into each
-/// with its caller's instruction set.
+/// The AVX-512 paths over nodes of eight ([`Isa::Avx512Nodes8`]): [`run_avx2`]'s code
+/// compiled with AVX-512 VL (32 vector registers, comparisons into mask registers;
+/// 1.02–1.03× faster than [`run_avx2`] on the Intel Xeon).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
+unsafe fn run_avx512_nodes8<Q: Query<P>, P: PrimitiveSet + ?Sized>(
+    nodes: &[WideNode<8>],
+    packets: &[Packet],
+    prims: &P,
+    r: &PreparedRay,
+    out: &mut Q::Out,
+) -> Q::Answer {
+    run_fused::<Q, P, 8>(nodes, packets, prims, r, out)
+}
+
+/// The body of [`run_avx2`], of [`run_avx512_nodes8`] and of [`run_avx512`]'s closest
+/// hits, compiled into each with its caller's instruction set.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
@@ -251,7 +268,7 @@ unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
     let rb = RayBoxes::new(r);
     match isa {
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
+        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 | Isa::Avx512Nodes8 => {
             Q::run::<Slab<lanes::Sse>, true, DEEP_STACK, W>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out)
         }
         _ => Q::run::<Slab<f32>, true, DEEP_STACK, W>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out),
@@ -271,8 +288,8 @@ impl Bvh {
             return Q::nothing(out);
         }
         // SAFETY: node and packet references were built by `wide::collapse` for these
-        // primitives, in nodes of `isa.node_width()` children (`nodes8` for AVX2,
-        // `nodes16` else), with at most `MAX_LEVELS` levels (asserted at build) and at
+        // primitives, in nodes of `isa.node_width()` children (`nodes8` for AVX2 and
+        // `Avx512Nodes8`, `nodes16` else), with at most `MAX_LEVELS` levels (asserted at build) and at
         // most `shallow_levels` unless `deep`; the AVX2 and AVX-512 paths are only taken
         // when the CPU has them (`isa` checked at build); SSE2 is part of x86-64.
         unsafe {
@@ -285,6 +302,8 @@ impl Bvh {
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx512 => run_avx512::<Q, P>(&self.nodes16, &self.packets, prims, r, out),
+                #[cfg(target_arch = "x86_64")]
+                Isa::Avx512Nodes8 => run_avx512_nodes8::<Q, P>(&self.nodes8, &self.packets, prims, r, out),
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx2 => run_avx2::<Q, P>(&self.nodes8, &self.packets, prims, r, out),
                 _ => run_portable::<Q, P>(self, prims, r, out),

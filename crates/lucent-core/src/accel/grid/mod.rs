@@ -335,8 +335,8 @@ fn cells_per_unit(ext: DVec3, cells: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ray::PreparedRay;
     use crate::accel::test_sets::Triangles;
+    use crate::ray::PreparedRay;
 
     #[test]
     fn a_scene_too_small_for_f32_volumes_gets_a_handful_of_cells() {
