@@ -6,10 +6,10 @@
 //! structure-of-arrays; leaves become packets of four primitives with precomputed
 //! triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): a box test per child per visit ([`box_test`]): sixteen with
-//! AVX-512 (in one group or two of eight), eight in one group with AVX2 and FMA (the
-//! instruction set decided once, at build time, with `is_x86_feature_detected!`), sixteen
-//! four at a time with SSE; nearest child first,
+//! Traversal ([`traverse`]): a box test per child per visit ([`box_test`]): with AVX-512
+//! sixteen (in one group or two of eight) on AMD, eight in one group elsewhere; eight in
+//! one group with AVX2 and FMA; sixteen four at a time with SSE (the instruction set and
+//! node width decided once, at build time, by [`Isa::detect`]); nearest child first,
 //! an explicit fixed-size stack, no allocation per ray; the packet test is bit-identical
 //! to the scalar watertight triangle test, so the answers are exactly the brute-force
 //! list's. Which box test and lane width a single ray's query runs on this CPU: [`query`].
@@ -330,19 +330,22 @@ mod tests {
     #[test]
     fn every_primitive_is_in_exactly_one_leaf_and_nodes_are_wide() {
         let prims = Triangles::random(11, 5000);
-        let bvh = Bvh::build(&prims);
-        let mut seen = bvh.leaf_prims();
-        seen.sort_unstable();
-        assert!(seen.iter().copied().eq(0..prims.0.len() as u32));
-        // A binary tree with leaves of up to four would need about n/2 nodes; wide nodes
-        // need several times fewer.
-        assert!(
-            bvh.node_count() > 50 && bvh.node_count() < prims.0.len() / 6,
-            "{}",
-            bvh.node_count()
-        );
-        // Packets are mostly full.
-        assert!(bvh.packets.len() * packet::LANES < prims.0.len() * 3 / 2);
+        // Both node widths (every instruction set this CPU has).
+        for isa in Isa::available() {
+            let bvh = Bvh::build_for(&prims, isa);
+            let mut seen = bvh.leaf_prims();
+            seen.sort_unstable();
+            assert!(seen.iter().copied().eq(0..prims.0.len() as u32), "{isa:?}");
+            // A binary tree with leaves of up to four would need about n/2 nodes; wide
+            // nodes need several times fewer.
+            assert!(
+                bvh.node_count() > 50 && bvh.node_count() < prims.0.len() / 6,
+                "{isa:?}: {}",
+                bvh.node_count()
+            );
+            // Packets are mostly full.
+            assert!(bvh.packets.len() * packet::LANES < prims.0.len() * 3 / 2, "{isa:?}");
+        }
     }
 
     /// The nodes and packets as bytes, to compare whole structures.
@@ -356,12 +359,14 @@ mod tests {
 
     #[test]
     fn the_parallel_build_is_the_one_thread_build_byte_for_byte() {
-        // Enough triangles for several levels of parallel subtrees.
+        // Enough triangles for several levels of parallel subtrees; every node width.
         let prims = Triangles::random(5, 120_000);
-        let expected = bytes(&pool(1).install(|| Bvh::build(&prims)));
-        for threads in [2, 5] {
-            let bvh = pool(threads).install(|| Bvh::build(&prims));
-            assert!(bytes(&bvh) == expected, "{threads} threads");
+        for isa in Isa::available() {
+            let expected = bytes(&pool(1).install(|| Bvh::build_for(&prims, isa)));
+            for threads in [2, 5] {
+                let bvh = pool(threads).install(|| Bvh::build_for(&prims, isa));
+                assert!(bytes(&bvh) == expected, "{isa:?}, {threads} threads");
+            }
         }
     }
 
@@ -370,7 +375,6 @@ mod tests {
         use crate::accel::test_sets::Rng;
         use crate::math::Vec3A;
         let prims = Triangles::random(3, 20_000);
-        let bvh = Bvh::build(&prims);
         let mut rng = Rng(77);
         // Camera-like rays from one point through a grid (coherent, in 8-ray rows), rays
         // from everywhere (incoherent), short shadow-like segments, and rays along an
@@ -409,20 +413,24 @@ mod tests {
             }
         }
         let prepared: Vec<PreparedRay> = rays.iter().copied().map(PreparedRay::new).collect();
-        let mut hits = vec![None; prepared.len()];
-        bvh.closest_hits(&prims, &rays, &mut hits);
-        let mut blocked = vec![false; prepared.len()];
-        bvh.occluded_rays(&prims, &rays, &mut blocked);
-        let mut found = 0;
-        for (i, r) in prepared.iter().enumerate() {
-            assert_eq!(hits[i], bvh.closest_hit(&prims, r), "ray {i}");
-            assert_eq!(blocked[i], bvh.occluded(&prims, r), "ray {i}");
-            found += hits[i].is_some() as usize;
+        // Every instruction set and node width this CPU has (each packet path).
+        for isa in Isa::available() {
+            let bvh = Bvh::build_for(&prims, isa);
+            let mut hits = vec![None; prepared.len()];
+            bvh.closest_hits(&prims, &rays, &mut hits);
+            let mut blocked = vec![false; prepared.len()];
+            bvh.occluded_rays(&prims, &rays, &mut blocked);
+            let mut found = 0;
+            for (i, r) in prepared.iter().enumerate() {
+                assert_eq!(hits[i], bvh.closest_hit(&prims, r), "{isa:?}, ray {i}");
+                assert_eq!(blocked[i], bvh.occluded(&prims, r), "{isa:?}, ray {i}");
+                found += hits[i].is_some() as usize;
+            }
+            assert!(
+                found > 500 && found < prepared.len() - 500,
+                "{isa:?}: {found} hits: a test of both"
+            );
         }
-        assert!(
-            found > 500 && found < prepared.len() - 500,
-            "{found} hits: a test of both"
-        );
     }
 
     #[test]
@@ -433,7 +441,7 @@ mod tests {
         let prims = Triangles::random(4, 20_000);
         let shallow = Bvh::build(&prims);
         let levels = shallow.levels();
-        // 20,000 triangles under nodes of sixteen (eight with AVX2) whose leaves hold at
+        // 20,000 triangles under nodes of sixteen (or eight) whose leaves hold at
         // most eight: at least 3 levels (16³ · 8 = 32,768), and SAH trees are not much
         // deeper.
         assert!((3..=14).contains(&levels), "{levels} levels");

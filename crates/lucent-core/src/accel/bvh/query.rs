@@ -98,9 +98,10 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     run_fused::<Q, P, 8>(nodes, packets, prims, r, out)
 }
 
-/// The AVX-512 paths over nodes of sixteen ([`Isa::Avx512`]). Closest hits run the same code as [`run_avx2`] (the same 8-lane
-/// operations, two groups per node), compiled with AVX-512 VL: 32 vector registers, so
-/// the ray's constants stay in registers, and comparisons into mask registers (measured
+/// The AVX-512 paths over nodes of sixteen ([`Isa::Avx512`]). Closest hits run the same
+/// code as [`run_avx2`] (the same 8-lane operations, two groups per node), compiled with
+/// AVX-512 VL: 32 vector registers, so the ray's constants stay in registers, and
+/// comparisons into mask registers (measured
 /// on an AMD EPYC, Zen 4: 1.05–1.11× faster than the AVX2 build). Any-hit queries test
 /// a node's sixteen boxes as one 16-lane group ([`lanes::Avx512`]): 1.037× on both
 /// dragons' shadow rays on that CPU. Closest hits lost 7 % that way there (0.927): they
