@@ -50,10 +50,9 @@ pub struct RaysBenchArgs {
     /// counts the worker threads' CPU time counts the tracing alone).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub build_threads: u32,
-    /// The BVH's instruction set and node width (default: the best this CPU has), to
-    /// compare them on one machine: avx512 (nodes of sixteen), avx512-nodes8, avx2 (nodes
-    /// of eight), sse2 or scalar (nodes of sixteen).
-    #[arg(long, value_parser = ["avx512", "avx512-nodes8", "avx2", "sse2", "scalar"])]
+    /// The BVH's instruction set (default: the best this CPU has), to compare them on
+    /// one machine: avx512, avx2, sse2 or scalar.
+    #[arg(long, value_parser = ["avx512", "avx2", "sse2", "scalar"])]
     pub isa: Option<String>,
     /// Trace the rays in packets of consecutive rays (16 with AVX-512, 8 with AVX2: the
     /// ray files' 8 × 8-tile order), as the renderer does for coherent rays (`bvh` only).
@@ -225,7 +224,6 @@ fn bench(args: &RaysBenchArgs) -> Result<(), String> {
         Some(name) => {
             let isa = match name {
                 "avx512" => Isa::Avx512,
-                "avx512-nodes8" => Isa::Avx512Nodes8,
                 "avx2" => Isa::Avx2,
                 "sse2" => Isa::Sse2,
                 _ => Isa::Scalar,

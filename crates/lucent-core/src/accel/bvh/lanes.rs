@@ -1,7 +1,6 @@
 //! A few `f32` lanes side by side, and the handful of operations the box test needs,
 //! written once per instruction set: plain `f32` (one lane), SSE (four), AVX (eight,
-//! with fused multiply–add), AVX-512 (sixteen, comparing into a mask register) and
-//! AVX-512 VL (eight, comparing into a mask register). The
+//! with fused multiply–add) and AVX-512 VL (eight, comparing into a mask register). The
 //! box tests of [`super::traverse`] are written once over this trait, so a wider
 //! instruction set costs one implementation here, not another copy of the test.
 //!
@@ -98,7 +97,7 @@ impl Lanes for f32 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx, Avx512, Avx512Vl8, Sse};
+pub use x86::{Avx, Avx512Vl8, Sse};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
@@ -184,20 +183,12 @@ mod x86 {
     }
 
     x86_lanes! {
-        /// Sixteen lanes (AVX-512 F): a whole node's boxes in one group, the comparisons
-        /// into a mask register, whose bits are the lanes'.
-        Avx512(__m512, __mmask16, 16):
-        splat _mm512_set1_ps, load _mm512_loadu_ps, store _mm512_storeu_ps,
-        [sub _mm512_sub_ps, mul _mm512_mul_ps, max _mm512_max_ps, min _mm512_min_ps],
-        le _mm512_cmp_ps_mask::<_CMP_LE_OQ>, and (|a: __mmask16, b: __mmask16| a & b), all 0xffff,
-        bits std::convert::identity
-    }
-
-    x86_lanes! {
         /// Eight lanes with AVX-512 VL: [`Avx`]'s operations, but comparisons into a mask
-        /// register (on the Intel Xeon 1.03–1.05× faster single rays over nodes of eight
-        /// than `Avx` compiled for AVX-512, which compares into a vector and moves its
-        /// signs out).
+        /// register. (On an Intel Xeon, `Avx` compiled for AVX-512, which compares into a
+        /// vector and moves its signs out, traced closest hits 1.17× slower over nodes of
+        /// sixteen. A sixteen-lane type over `__m512`, a whole node in one group, traced
+        /// any-hit queries 1.07–1.15× slower there; on an AMD EPYC, Zen 4, it had been
+        /// 1.037× faster than two groups of `Avx`: see `run_avx512`.)
         Avx512Vl8(__m256, __mmask8, 8):
         splat _mm256_set1_ps, load _mm256_load_ps, store _mm256_storeu_ps,
         [sub _mm256_sub_ps, mul _mm256_mul_ps, max _mm256_max_ps, min _mm256_min_ps],
@@ -209,13 +200,6 @@ mod x86 {
         #[inline(always)]
         unsafe fn mul_sub(self, b: Avx512Vl8, c: Avx512Vl8) -> Avx512Vl8 {
             Avx512Vl8(_mm256_fmsub_ps(self.0, b.0, c.0))
-        }
-    }
-
-    impl FusedLanes for Avx512 {
-        #[inline(always)]
-        unsafe fn mul_sub(self, b: Avx512, c: Avx512) -> Avx512 {
-            Avx512(_mm512_fmsub_ps(self.0, b.0, c.0))
         }
     }
 }

@@ -1,15 +1,15 @@
-//! Bounding volume hierarchy (`--accel bvh`, the default): a 16-wide or 8-wide BVH (the
-//! width chosen with the CPU, [`Isa::available`]) over packets of four triangles.
+//! Bounding volume hierarchy (`--accel bvh`, the default): a 16-wide BVH (8-wide on CPUs
+//! whose best is AVX2) over packets of four triangles.
 //!
 //! Build ([`binary`], [`wide`]): a binned-SAH binary tree, collapsed into nodes of sixteen
-//! children or of eight ([`Isa::node_width`]) whose boxes are stored as
+//! children (eight for AVX2, [`Isa::node_width`]) whose boxes are stored as
 //! structure-of-arrays; leaves become packets of four primitives with precomputed
 //! triangle corners in SIMD layout ([`packet`]).
 //!
-//! Traversal ([`traverse`]): a box test per child per visit ([`box_test`]): with AVX-512
-//! sixteen (in one group or two of eight) on AMD, eight in one group elsewhere; eight in
-//! one group with AVX2 and FMA; sixteen four at a time with SSE (the instruction set and
-//! node width decided once, at build time, by [`Isa::detect`]); nearest child first,
+//! Traversal ([`traverse`]): a box test per child per visit ([`box_test`]): sixteen with
+//! AVX-512 (two groups of eight, compared into mask registers), eight in one group with
+//! AVX2 and FMA, sixteen four at a time with SSE (the instruction set decided once, at
+//! build time, by [`Isa::detect`]); nearest child first,
 //! an explicit fixed-size stack, no allocation per ray; the packet test is bit-identical
 //! to the scalar watertight triangle test, so the answers are exactly the brute-force
 //! list's. Which box test and lane width a single ray's query runs on this CPU: [`query`].
@@ -46,13 +46,9 @@ use wide::WideNode;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Isa {
     /// AVX-512 F, VL and BW (with AVX2 and FMA) over nodes of sixteen: packets of sixteen
-    /// rays; closest hits take the AVX2 code (eight boxes at a time) compiled for AVX-512,
-    /// any-hit queries sixteen boxes at a time (see `run_avx512`). The best on AMD's
-    /// AVX-512 CPUs.
+    /// rays; single rays test a node's boxes eight at a time, compared into mask
+    /// registers (see `run_avx512`).
     Avx512,
-    /// AVX-512 over nodes of eight: the AVX2 code compiled for AVX-512 for single rays
-    /// (one group of eight boxes a visit), packets of sixteen rays. The best on Intel's.
-    Avx512Nodes8,
     /// AVX2 with FMA (every AVX2 CPU has both): packets of eight rays.
     Avx2,
     Sse2,
@@ -65,11 +61,7 @@ impl Isa {
         Isa::available()[0]
     }
 
-    /// Every instruction set this CPU can run, best first. With AVX-512 the node width
-    /// goes with the maker: nodes of sixteen on AMD (Zen 4 measured them 1.02–1.06×
-    /// faster than nodes of eight on single rays), of eight elsewhere (an Intel Xeon with
-    /// full-width AVX-512 measured eight 1.07–1.18× faster on closest hits, 1.05–1.15×
-    /// on whole path-traced and Whitted renders; see docs/performance.md).
+    /// Every instruction set this CPU can run, best first.
     pub fn available() -> Vec<Isa> {
         #[cfg(target_arch = "x86_64")]
         {
@@ -77,11 +69,7 @@ impl Isa {
             let mut v = Vec::new();
             let avx2 = has!("avx2") && has!("fma");
             if avx2 && has!("avx512f") && has!("avx512vl") && has!("avx512bw") {
-                if is_amd() {
-                    v.extend([Isa::Avx512, Isa::Avx512Nodes8]);
-                } else {
-                    v.extend([Isa::Avx512Nodes8, Isa::Avx512]);
-                }
+                v.push(Isa::Avx512);
             }
             if avx2 {
                 v.push(Isa::Avx2);
@@ -97,45 +85,30 @@ impl Isa {
 
     /// Whether this CPU has AVX2 and FMA (the fused box test and packets).
     pub fn has_avx2(self) -> bool {
-        matches!(self, Isa::Avx512 | Isa::Avx512Nodes8 | Isa::Avx2)
+        matches!(self, Isa::Avx512 | Isa::Avx2)
     }
 
-    /// Whether this is one of the AVX-512 paths.
-    pub fn is_avx512(self) -> bool {
-        matches!(self, Isa::Avx512 | Isa::Avx512Nodes8)
-    }
-
-    /// The children of the tree's nodes: eight for AVX2 and [`Isa::Avx512Nodes8`], tested
-    /// in one group; else sixteen, tested in one AVX-512 group (or two AVX2-wide groups,
-    /// four SSE ones). (Measured on an AMD EPYC without AVX-512, Zen 3: nodes of eight
-    /// 1.01–1.09× faster on primary rays than nodes of sixteen tested as two groups,
-    /// 0.98–1.08× on the other sets and packets; see docs/performance.md.)
+    /// The children of the tree's nodes: sixteen, tested in two AVX-512 VL groups of
+    /// eight (two AVX2-wide groups, four SSE ones), except for AVX2, which tests a node
+    /// of eight in one group. (Measured on an AMD EPYC without AVX-512, Zen 3: nodes of
+    /// eight 1.01–1.09× faster on primary rays than nodes of sixteen tested as two
+    /// groups, 0.98–1.08× on the other sets and packets; with AVX-512, on an Intel Xeon,
+    /// nodes of sixteen 1.00–1.07× faster than eight when both compare into mask
+    /// registers; see docs/performance.md.)
     pub fn node_width(self) -> usize {
         match self {
-            Isa::Avx2 | Isa::Avx512Nodes8 => 8,
+            Isa::Avx2 => 8,
             _ => 16,
         }
     }
 
     /// How many rays a packet holds.
     pub fn packet_rays(self) -> usize {
-        if self.is_avx512() {
-            16
-        } else {
-            8
+        match self {
+            Isa::Avx512 => 16,
+            _ => 8,
         }
     }
-}
-
-/// Whether the CPU's maker is AMD (CPUID leaf 0's vendor string "AuthenticAMD").
-#[cfg(target_arch = "x86_64")]
-fn is_amd() -> bool {
-    // SAFETY: CPUID leaf 0 exists on every x86-64 CPU. (`unsafe` for the toolchains
-    // on which `__cpuid` is still an unsafe function.)
-    #[allow(unused_unsafe)]
-    let id = unsafe { std::arch::x86_64::__cpuid(0) };
-    // "Auth" "enti" "cAMD" in EBX, EDX, ECX.
-    (id.ebx, id.edx, id.ecx) == (0x6874_7541, 0x6974_6e65, 0x444d_4163)
 }
 
 pub struct Bvh {
@@ -240,17 +213,13 @@ impl Bvh {
                 }
                 let (packets, states) = (&self.packets, &mut states[..chunk.len()]);
                 // SAFETY: `isa` was checked against the CPU when the tree was built for
-                // these primitives (in nodes of `isa.node_width()`: `nodes16` for
-                // `Avx512`, `nodes8` else), and the tree is not deep.
+                // these primitives (nodes of sixteen for AVX-512, eight for AVX2), and
+                // the tree is not deep.
                 let alone = unsafe {
-                    match self.isa {
-                        Isa::Avx512 => {
-                            ray_packet::traverse_avx512::<Q, P, 16>(&self.nodes16, packets, prims, chunk, states)
-                        }
-                        Isa::Avx512Nodes8 => {
-                            ray_packet::traverse_avx512::<Q, P, 8>(&self.nodes8, packets, prims, chunk, states)
-                        }
-                        _ => ray_packet::traverse_avx2::<Q, P, 8>(&self.nodes8, packets, prims, chunk, states),
+                    if self.isa == Isa::Avx512 {
+                        ray_packet::traverse_avx512::<Q, P, 16>(&self.nodes16, packets, prims, chunk, states)
+                    } else {
+                        ray_packet::traverse_avx2::<Q, P, 8>(&self.nodes8, packets, prims, chunk, states)
                     }
                 };
                 for i in packet::Lanes(alone) {
@@ -330,7 +299,7 @@ mod tests {
     #[test]
     fn every_primitive_is_in_exactly_one_leaf_and_nodes_are_wide() {
         let prims = Triangles::random(11, 5000);
-        // Both node widths (every instruction set this CPU has).
+        // Every instruction set this CPU has (both node widths on an AVX2 CPU).
         for isa in Isa::available() {
             let bvh = Bvh::build_for(&prims, isa);
             let mut seen = bvh.leaf_prims();
@@ -359,9 +328,15 @@ mod tests {
 
     #[test]
     fn the_parallel_build_is_the_one_thread_build_byte_for_byte() {
-        // Enough triangles for several levels of parallel subtrees; every node width.
+        // Enough triangles for several levels of parallel subtrees; each node width this
+        // CPU builds (the build depends on the instruction set only through it).
         let prims = Triangles::random(5, 120_000);
+        let mut widths = Vec::new();
         for isa in Isa::available() {
+            if widths.contains(&isa.node_width()) {
+                continue;
+            }
+            widths.push(isa.node_width());
             let expected = bytes(&pool(1).install(|| Bvh::build_for(&prims, isa)));
             for threads in [2, 5] {
                 let bvh = pool(threads).install(|| Bvh::build_for(&prims, isa));
@@ -413,7 +388,7 @@ mod tests {
             }
         }
         let prepared: Vec<PreparedRay> = rays.iter().copied().map(PreparedRay::new).collect();
-        // Every instruction set and node width this CPU has (each packet path).
+        // Every instruction set this CPU has (each packet path).
         for isa in Isa::available() {
             let bvh = Bvh::build_for(&prims, isa);
             let mut hits = vec![None; prepared.len()];

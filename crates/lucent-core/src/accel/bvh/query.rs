@@ -23,9 +23,6 @@ pub(super) trait Query<P: PrimitiveSet + ?Sized> {
     type Answer;
     /// The answer when the tree is empty.
     fn nothing(out: &mut Self::Out) -> Self::Answer;
-    /// Whether the query visits children nearest first (and so needs their entry
-    /// distances): closest hits do, any-hit queries do not.
-    const ORDERED: bool;
     /// # Safety
     /// `T`'s instructions must be available, `ZERO` set when the ray has a zero
     /// direction component, and the tree (`nodes`, `packets`) built for `prims` and at
@@ -49,7 +46,6 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Closest {
     fn nothing(out: &mut Option<Hit>) {
         *out = None;
     }
-    const ORDERED: bool = true;
     #[inline(always)]
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize, const W: usize>(
         nodes: &[WideNode<W>],
@@ -69,7 +65,6 @@ impl<P: PrimitiveSet + ?Sized> Query<P> for Occluded {
     fn nothing(_: &mut ()) -> bool {
         false
     }
-    const ORDERED: bool = false;
     #[inline(always)]
     unsafe fn run<T: BoxTest, const ZERO: bool, const STACK: usize, const W: usize>(
         nodes: &[WideNode<W>],
@@ -98,19 +93,18 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     run_fused::<Q, P, 8>(nodes, packets, prims, r, out)
 }
 
-/// The AVX-512 paths over nodes of sixteen ([`Isa::Avx512`]). Closest hits run the same
-/// code as [`run_avx2`] (the same 8-lane operations, two groups per node), compiled with
-/// AVX-512 VL: 32 vector registers, so the ray's constants stay in registers, and
-/// comparisons into mask registers (measured
-/// on an AMD EPYC, Zen 4: 1.05–1.11× faster than the AVX2 build). Any-hit queries test
-/// a node's sixteen boxes as one 16-lane group ([`lanes::Avx512`]): 1.037× on both
-/// dragons' shadow rays on that CPU. Closest hits lost 7 % that way there (0.927): they
-/// read the children's entry distances back from memory to order them, and storing the
-/// distances as two 256-bit halves brought that to 0.975, so part of the loss is Zen 4
-/// forwarding a 512-bit store to the loads that follow; any-hit queries need no
-/// distances. (On an Intel Xeon with full-width AVX-512, closest hits as one 16-lane group
-/// were 1.02–1.10× faster than as two groups, but nodes of eight, [`run_avx512_nodes8`],
-/// 1.07–1.18×: there the tree has nodes of eight.)
+/// The AVX-512 paths ([`Isa::Avx512`], nodes of sixteen): both queries test a node's
+/// boxes as two groups of eight lanes of AVX-512 VL ([`lanes::Avx512Vl8`]: 32 vector
+/// registers, so the ray's constants stay in registers, and comparisons into mask
+/// registers).
+///
+/// Measured on an Intel Xeon with full-width AVX-512 (docs/performance.md, 2026-11-30),
+/// paired: against the same operations comparing into vectors ([`run_avx2`]'s code
+/// compiled for AVX-512, which closest hits ran before) 1.17–1.18× on the 100k dragon's
+/// closest hits; against any-hit queries as one 16-lane group (which they ran before,
+/// measured 1.037× faster than two vector-compared groups on an AMD EPYC, Zen 4) about
+/// 1.15× (100k dragon) and 1.07× (1.6M); and against nodes of eight with the same
+/// lanes 1.00–1.07×. On the Zen 4 this path is still to be measured.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
@@ -121,11 +115,8 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     out: &mut Q::Out,
 ) -> Q::Answer {
     use box_test::Fused;
-    if Q::ORDERED {
-        return run_fused::<Q, P, 16>(nodes, packets, prims, r, out);
-    }
     match FmaOffsets::new(r) {
-        Some(offsets) => Q::run::<Fused<lanes::Avx512>, false, SHALLOW_STACK, 16>(
+        Some(offsets) => Q::run::<Fused<lanes::Avx512Vl8>, false, SHALLOW_STACK, 16>(
             nodes,
             packets,
             prims,
@@ -137,36 +128,7 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     }
 }
 
-/// The AVX-512 paths over nodes of eight ([`Isa::Avx512Nodes8`]): [`run_avx2`]'s test
-/// with AVX-512 VL's eight lanes ([`lanes::Avx512Vl8`]: 32 vector registers, comparisons
-/// into mask registers). On the Intel Xeon: [`run_avx2`]'s own code compiled for AVX-512
-/// ran at 0.99–1.03× [`run_avx2`] on closest hits, 1.02–1.04× on any-hit queries; the
-/// mask comparisons made it 1.03–1.05× faster again.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
-unsafe fn run_avx512_nodes8<Q: Query<P>, P: PrimitiveSet + ?Sized>(
-    nodes: &[WideNode<8>],
-    packets: &[Packet],
-    prims: &P,
-    r: &PreparedRay,
-    out: &mut Q::Out,
-) -> Q::Answer {
-    use box_test::Fused;
-    match FmaOffsets::new(r) {
-        Some(offsets) => Q::run::<Fused<lanes::Avx512Vl8>, false, SHALLOW_STACK, 8>(
-            nodes,
-            packets,
-            prims,
-            r,
-            &Fused::prepare(&RayBoxes::new(r), &offsets, nodes),
-            out,
-        ),
-        None => run_avx2_plain::<Q, P, 8>(nodes, packets, prims, r, out),
-    }
-}
-
-/// The body of [`run_avx2`], of [`run_avx512_nodes8`] and of [`run_avx512`]'s closest
-/// hits, compiled into each with its caller's instruction set.
+/// The body of [`run_avx2`].
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
@@ -282,7 +244,7 @@ unsafe fn run_deep<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
     let rb = RayBoxes::new(r);
     match isa {
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 | Isa::Avx512Nodes8 => {
+        Isa::Sse2 | Isa::Avx2 | Isa::Avx512 => {
             Q::run::<Slab<lanes::Sse>, true, DEEP_STACK, W>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out)
         }
         _ => Q::run::<Slab<f32>, true, DEEP_STACK, W>(nodes, packets, prims, r, &Slab::prepare(&rb, nodes), out),
@@ -302,8 +264,8 @@ impl Bvh {
             return Q::nothing(out);
         }
         // SAFETY: node and packet references were built by `wide::collapse` for these
-        // primitives, in nodes of `isa.node_width()` children (`nodes8` for AVX2 and
-        // `Avx512Nodes8`, `nodes16` else), with at most `MAX_LEVELS` levels (asserted at build) and at
+        // primitives, in nodes of `isa.node_width()` children (`nodes8` for AVX2,
+        // `nodes16` else), with at most `MAX_LEVELS` levels (asserted at build) and at
         // most `shallow_levels` unless `deep`; the AVX2 and AVX-512 paths are only taken
         // when the CPU has them (`isa` checked at build); SSE2 is part of x86-64.
         unsafe {
@@ -316,8 +278,6 @@ impl Bvh {
             match self.isa {
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx512 => run_avx512::<Q, P>(&self.nodes16, &self.packets, prims, r, out),
-                #[cfg(target_arch = "x86_64")]
-                Isa::Avx512Nodes8 => run_avx512_nodes8::<Q, P>(&self.nodes8, &self.packets, prims, r, out),
                 #[cfg(target_arch = "x86_64")]
                 Isa::Avx2 => run_avx2::<Q, P>(&self.nodes8, &self.packets, prims, r, out),
                 _ => run_portable::<Q, P>(self, prims, r, out),

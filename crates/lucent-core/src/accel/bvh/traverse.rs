@@ -1,7 +1,7 @@
 //! Walking the wide BVH: closest-hit and any-hit queries.
 //!
-//! Each node visit tests the ray against all the node's child boxes, `W` of them (sixteen
-//! or eight, [`super::Isa::node_width`]; [`super::box_test`]),
+//! Each node visit tests the ray against all the node's child boxes, `W` of them (sixteen,
+//! or eight in the AVX2 trees; [`super::box_test`]),
 //! then continues with the nearest child and pushes the others, farthest first, on a
 //! fixed stack together with their entry distance; a popped entry that starts beyond the
 //! closest hit found since is dropped.

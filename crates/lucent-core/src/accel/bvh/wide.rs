@@ -17,9 +17,8 @@
 //! Why eight with AVX2: on a CPU without AVX-512 (an AMD EPYC, Zen 3) nodes of eight,
 //! one AVX2 group a visit, traced primary rays 1.01–1.09× faster and the others about
 //! the same (sixteen vector registers do not hold a ray's constants and two groups).
-//! And why eight with AVX-512 on Intel: on an Intel Xeon with full-width AVX-512 nodes
-//! of eight made closest hits 1.07–1.18× faster than nodes of sixteen (two groups, or
-//! one 16-lane group: 1.02–1.10×), any-hit queries 0.94–1.03×.
+//! With AVX-512 on an Intel Xeon, nodes of sixteen were 1.00–1.07× faster than nodes of
+//! eight, both tested eight boxes at a time into mask registers.
 //!
 //! Leaves become runs of four-wide packets, laid out in the order traversal meets them.
 //! With more than one thread, large subtrees are laid out by tasks of their own, each as
@@ -31,8 +30,8 @@ use super::collapse_plan::{Plan, MERGE};
 use super::packet::{Packet, LANES};
 use crate::accel::PrimitiveSet;
 
-/// The most children a node has: sixteen (AVX-512 on AMD, and the portable paths); the
-/// other trees have eight ([`super::Isa::node_width`]).
+/// The most children a node has: sixteen for AVX-512 (and the portable paths), eight for
+/// AVX2 (see [`super::Isa::node_width`]).
 pub const MAX_WIDTH: usize = 16;
 /// A child slot that is a leaf: `LEAF | (packets - 1) << PACKET_SHIFT | first packet`;
 /// an interior child is the byte offset of its node in the node array.
