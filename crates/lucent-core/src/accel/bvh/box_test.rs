@@ -1,7 +1,7 @@
 //! The box test of a BVH node visit: one ray against a node's child boxes (sixteen, or
-//! eight in the AVX2 trees), all sixteen at once with AVX-512 (any-hit queries), eight at
-//! a time with AVX when the CPU has it (detected at run time), else four at a time with
-//! SSE (the tests are written once over the lanes of [`super::lanes`]), giving which
+//! eight in the AVX2 trees), eight at a time with AVX-512 VL (compared into mask
+//! registers) or AVX when the CPU has them (detected at run time), else four at a time
+//! with SSE (the tests are written once over the lanes of [`super::lanes`]), giving which
 //! boxes it enters and at what distance.
 //!
 //! Every box test is conservative: it never rejects a box the exact slab test enters.

@@ -6,7 +6,8 @@
 //! eight primitives, one or two packets) or a wide node of its own. Which cut, and which
 //! subtrees become leaves, is the plan of [`super::collapse_plan`]: the least expected
 //! cost by the surface area heuristic. The node stores its children's boxes as
-//! structure-of-arrays, so two AVX instructions (one AVX-512, four SSE) test all sixteen.
+//! structure-of-arrays, so two eight-lane instructions (AVX, or AVX-512 VL; four SSE) test
+//! all sixteen.
 //!
 //! Why sixteen: a single ray's walk waits, at every node, on the chain from loading a
 //! child's reference to choosing the next child, so fewer levels are fewer waits; the
