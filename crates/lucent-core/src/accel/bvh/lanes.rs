@@ -187,7 +187,7 @@ mod x86 {
         /// register. (On an Intel Xeon, `Avx` compiled for AVX-512, which compares into a
         /// vector and moves its signs out, traced closest hits 1.17× slower over nodes of
         /// sixteen. A sixteen-lane type over `__m512`, a whole node in one group, traced
-        /// any-hit queries 1.07–1.15× slower there; on an AMD EPYC, Zen 4, it had been
+        /// any-hit queries 1.07–1.19× slower there; on an AMD EPYC, Zen 4, it had been
         /// 1.037× faster than two groups of `Avx`: see `run_avx512`.)
         Avx512Vl8(__m256, __mmask8, 8):
         splat _mm256_set1_ps, load _mm256_load_ps, store _mm256_storeu_ps,

@@ -101,10 +101,12 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
 /// Measured on an Intel Xeon with full-width AVX-512 (docs/performance.md, 2026-11-30),
 /// paired: against the same operations comparing into vectors ([`run_avx2`]'s code
 /// compiled for AVX-512, which closest hits ran before) 1.17–1.18× on the 100k dragon's
-/// closest hits; against any-hit queries as one 16-lane group (which they ran before,
-/// measured 1.037× faster than two vector-compared groups on an AMD EPYC, Zen 4) about
-/// 1.15× (100k dragon) and 1.07× (1.6M); and against nodes of eight with the same
-/// lanes 1.00–1.07×. On the Zen 4 this path is still to be measured.
+/// closest hits; against nodes of eight with the same lanes 1.00–1.07× on every set. Any-hit
+/// queries ran as one 16-lane group before (measured 1.037× faster than two
+/// vector-compared groups on an AMD EPYC, Zen 4); each paired against nodes of eight,
+/// that group made the dragons' shadow rays 0.871× and 1.004×, two mask-compared groups
+/// 1.034× and 1.070×: about 1.19× and 1.07× between the two. On the Zen 4 this path is
+/// still to be measured.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx2,fma")]
 unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
