@@ -90,7 +90,7 @@ unsafe fn run_avx2<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
-    run_fused::<Q, P, 8>(nodes, packets, prims, r, out)
+    run_fused::<Q, P, lanes::Avx, 8>(nodes, packets, prims, r, out)
 }
 
 /// The AVX-512 paths ([`Isa::Avx512`], nodes of sixteen): both queries test a node's
@@ -116,24 +116,15 @@ unsafe fn run_avx512<Q: Query<P>, P: PrimitiveSet + ?Sized>(
     r: &PreparedRay,
     out: &mut Q::Out,
 ) -> Q::Answer {
-    use box_test::Fused;
-    match FmaOffsets::new(r) {
-        Some(offsets) => Q::run::<Fused<lanes::Avx512Vl8>, false, SHALLOW_STACK, 16>(
-            nodes,
-            packets,
-            prims,
-            r,
-            &Fused::prepare(&RayBoxes::new(r), &offsets, nodes),
-            out,
-        ),
-        None => run_avx2_plain::<Q, P, 16>(nodes, packets, prims, r, out),
-    }
+    run_fused::<Q, P, lanes::Avx512Vl8, 16>(nodes, packets, prims, r, out)
 }
 
-/// The body of [`run_avx2`].
+/// The body of [`run_avx2`] and [`run_avx512`], compiled into each with its caller's
+/// instruction set: the fused box test on lanes `L` for rays that have its constants,
+/// the plain one for the others.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
+unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, L: lanes::FusedLanes, const W: usize>(
     nodes: &[WideNode<W>],
     packets: &[Packet],
     prims: &P,
@@ -143,9 +134,8 @@ unsafe fn run_fused<Q: Query<P>, P: PrimitiveSet + ?Sized, const W: usize>(
     // The ray's constants are made here, in this function, rather than passed in: handing
     // them over through memory costs a stalled store-to-load forward per ray.
     use box_test::Fused;
-    use lanes::Avx;
     if let Some(offsets) = FmaOffsets::new(r) {
-        Q::run::<Fused<Avx>, false, SHALLOW_STACK, W>(
+        Q::run::<Fused<L>, false, SHALLOW_STACK, W>(
             nodes,
             packets,
             prims,

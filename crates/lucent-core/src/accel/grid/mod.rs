@@ -200,7 +200,7 @@ impl Grid {
         let cells = self.cell_start.len() - 1;
         let crowded = NESTED_AT.max(NESTED_CROWD * self.prim_ids.len() / cells);
         for c in 0..cells {
-            let ids = &self.prim_ids[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+            let ids = self.cell_prims(c);
             if ids.len() <= crowded {
                 continue;
             }
@@ -268,6 +268,12 @@ impl Grid {
             min: lo,
             max: lo + self.cell_size,
         }
+    }
+
+    /// The primitives of cell `c` (an index, [`Grid::index`]).
+    #[inline(always)]
+    fn cell_prims(&self, c: usize) -> &[u32] {
+        &self.prim_ids[self.cell_start[c] as usize..self.cell_start[c + 1] as usize]
     }
 
     fn index(&self, c: [usize; 3]) -> usize {

@@ -254,7 +254,7 @@ impl Grid {
                     for y in b0..=b1 {
                         at[minor[0].index] = y;
                         let i = self.index(at);
-                        let list = &self.prim_ids[self.cell_start[i] as usize..self.cell_start[i + 1] as usize];
+                        let list = self.cell_prims(i);
                         // (An empty cell changes nothing: `cell` would return the same
                         // limit. Most cells a ray crosses are empty, and `cell` is not
                         // inlined into this loop.)
@@ -296,7 +296,7 @@ impl Grid {
     #[inline(never)]
     fn visit_all<F: FnMut(&[u32]) -> Option<f32>>(&self, mut limit: f32, cell: &mut F) -> Option<f32> {
         for c in 0..self.cell_start.len() - 1 {
-            let list = &self.prim_ids[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+            let list = self.cell_prims(c);
             if !list.is_empty() {
                 limit = cell(list)?;
             }
